@@ -1,0 +1,128 @@
+//! Triangle meshes from Wavefront OBJ files (read with `tobj`), baked into
+//! world space by their transform, with optional vertex normals and uv.
+
+use super::transform::Transform;
+use super::triangle::Triangle;
+use glam::{DVec2, DVec3};
+use std::path::Path;
+
+/// Shared per-vertex attributes of a mesh; faces index into them.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    pub positions: Vec<DVec3>,
+    pub normals: Vec<DVec3>,
+    pub uvs: Vec<DVec2>,
+    /// Per face: position indices; normals and uv use the same indices
+    /// (tobj's single-index mode).
+    pub faces: Vec<[u32; 3]>,
+}
+
+impl Mesh {
+    /// Loads every model in an OBJ file into one mesh, triangulating polygons.
+    pub fn load_obj(path: &Path, transform: &Transform) -> Result<Self, String> {
+        let options = tobj::LoadOptions {
+            triangulate: true,
+            single_index: true,
+            ignore_points: true,
+            ignore_lines: true,
+        };
+        let (models, _materials) = tobj::load_obj(path, &options).map_err(|e| format!("cannot read OBJ: {e}"))?;
+        let mut mesh = Mesh::default();
+        for model in &models {
+            let m = &model.mesh;
+            let base = mesh.positions.len() as u32;
+            let vertex_count = m.positions.len() / 3;
+            mesh.positions.extend(
+                m.positions
+                    .chunks_exact(3)
+                    .map(|p| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)),
+            );
+            let has_normals = m.normals.len() == m.positions.len();
+            let has_uvs = m.texcoords.len() / 2 == vertex_count;
+            if has_normals {
+                mesh.normals.extend(m.normals.chunks_exact(3).map(|n| DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64)));
+            }
+            if has_uvs {
+                mesh.uvs.extend(m.texcoords.chunks_exact(2).map(|t| DVec2::new(t[0] as f64, t[1] as f64)));
+            }
+            for face in m.indices.chunks_exact(3) {
+                let f = [face[0] + base, face[1] + base, face[2] + base];
+                if f.iter().any(|&i| i as usize >= mesh.positions.len()) {
+                    return Err("a face refers to a vertex that does not exist".into());
+                }
+                mesh.faces.push(f);
+            }
+        }
+        // Attributes are kept only if every model supplied them.
+        if mesh.normals.len() != mesh.positions.len() {
+            mesh.normals.clear();
+        }
+        if mesh.uvs.len() != mesh.positions.len() {
+            mesh.uvs.clear();
+        }
+        if mesh.faces.is_empty() {
+            return Err("the OBJ file has no triangles".into());
+        }
+        if mesh.positions.iter().any(|p| !p.is_finite()) {
+            return Err("the OBJ file has a non-finite vertex position".into());
+        }
+        mesh.apply(transform);
+        Ok(mesh)
+    }
+
+    /// Moves the mesh into world space.
+    pub fn apply(&mut self, transform: &Transform) {
+        if transform.is_identity() {
+            return;
+        }
+        for p in &mut self.positions {
+            *p = transform.point(*p);
+        }
+        let normal_matrix = transform.normal_matrix();
+        for n in &mut self.normals {
+            *n = (normal_matrix * *n).normalize_or_zero();
+        }
+    }
+
+    /// The mesh's triangles as primitives, tagged with `mesh_index`.
+    /// Degenerate (zero-area) faces are dropped: they can never be hit.
+    pub fn triangles(&self, mesh_index: u32) -> impl Iterator<Item = Triangle> + '_ {
+        self.faces.iter().enumerate().filter_map(move |(face, f)| {
+            let triangle = Triangle {
+                vertices: f.map(|i| self.positions[i as usize]),
+                mesh: mesh_index,
+                face: face as u32,
+            };
+            (triangle.area() > 0.0).then_some(triangle)
+        })
+    }
+
+    /// Interpolated shading normal (if the mesh has normals) and uv (the
+    /// barycentric coordinates when it has none) at a point of a face.
+    pub fn shading(&self, face: usize, barycentric: [f64; 3]) -> (Option<DVec3>, DVec2) {
+        let f = self.faces[face];
+        let normal = (!self.normals.is_empty())
+            .then(|| {
+                let n = (0..3).map(|k| barycentric[k] * self.normals[f[k] as usize]).sum::<DVec3>();
+                n.try_normalize()
+            })
+            .flatten();
+        let uv = if self.uvs.is_empty() {
+            DVec2::new(barycentric[1], barycentric[2])
+        } else {
+            (0..3).map(|k| barycentric[k] * self.uvs[f[k] as usize]).sum()
+        };
+        (normal, uv)
+    }
+
+    /// A mesh of explicit triangles (the scene file's `triangle` objects).
+    pub fn from_triangles(triangles: &[[DVec3; 3]]) -> Self {
+        let mut mesh = Mesh::default();
+        for (i, t) in triangles.iter().enumerate() {
+            mesh.positions.extend_from_slice(t);
+            let base = 3 * i as u32;
+            mesh.faces.push([base, base + 1, base + 2]);
+        }
+        mesh
+    }
+}

@@ -1,0 +1,119 @@
+//! Spheres, intersected with the cancellation-free quadratic of Haines et al.
+//! (Ray Tracing Gems, ch. 7) so that smallpt's radius-1e5 walls stay exact.
+
+use super::hit::{AreaSample, SurfaceHit};
+use crate::math::{Aabb, Ray, gamma, warp};
+use glam::{DVec2, DVec3};
+use std::f64::consts::PI;
+
+#[derive(Clone, Copy, Debug)]
+pub struct Sphere {
+    pub center: DVec3,
+    pub radius: f64,
+}
+
+impl Sphere {
+    pub fn bounds(&self) -> Aabb {
+        Aabb::new(self.center - DVec3::splat(self.radius), self.center + DVec3::splat(self.radius))
+    }
+
+    pub fn area(&self) -> f64 {
+        4.0 * PI * self.radius * self.radius
+    }
+
+    /// Nearest hit in `(0, t_max)`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
+        let f = ray.origin - self.center;
+        let b = f.dot(ray.direction);
+        let c = f.length_squared() - self.radius * self.radius;
+        // r² - |f - (f·d) d|² equals b² - c but without subtracting two
+        // nearly equal large numbers when the ray passes far from the centre.
+        let closest = f - b * ray.direction;
+        let discriminant = self.radius * self.radius - closest.length_squared();
+        if discriminant < 0.0 {
+            return None;
+        }
+        let q = -b - discriminant.sqrt().copysign(b);
+        let (t0, t1) = {
+            let a = c / q;
+            if a < q { (a, q) } else { (q, a) }
+        };
+        let t = if t0 > 0.0 && t0 < t_max {
+            t0
+        } else if t1 > 0.0 && t1 < t_max {
+            t1
+        } else {
+            return None;
+        };
+        Some(self.hit_at(ray.at(t), t))
+    }
+
+    /// The hit record for a point near the surface, reprojected onto it.
+    fn hit_at(&self, approximate_point: DVec3, t: f64) -> SurfaceHit {
+        let normal = (approximate_point - self.center).normalize();
+        let point = self.center + self.radius * normal;
+        // Reprojection error: a handful of roundings on |p| (pbrt-v4 6.8.5).
+        let point_error = gamma(5) * (point.abs() + self.center.abs());
+        SurfaceHit {
+            t,
+            point,
+            point_error,
+            geometric_normal: normal,
+            shading_normal: normal,
+            uv: Self::uv_of(normal),
+        }
+    }
+
+    /// Equirectangular coordinates of a unit direction from the centre:
+    /// u = 0.5 + longitude / 2π with longitude 0 towards +z (so u = 0.5 faces
+    /// a camera on the +z axis), v = polar angle / π, 0 at +y (north).
+    pub fn uv_of(direction: DVec3) -> DVec2 {
+        let longitude = direction.x.atan2(direction.z); // 0 towards +z
+        let u = 0.5 + longitude / (2.0 * PI);
+        let v = direction.y.clamp(-1.0, 1.0).acos() / PI;
+        DVec2::new(u, v)
+    }
+
+    /// Uniform point on the surface; density `1 / area`.
+    pub fn sample_area(&self, u: DVec2) -> AreaSample {
+        let normal = warp::square_to_uniform_sphere(u);
+        let hit = self.hit_at(self.center + self.radius * normal, 0.0);
+        AreaSample {
+            point: hit.point,
+            point_error: hit.point_error,
+            normal,
+            uv: hit.uv,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hits_at_known_distances_from_outside_and_inside() {
+        let s = Sphere { center: DVec3::new(0.0, 0.0, 5.0), radius: 1.0 };
+        let outside = s.intersect(&Ray::new(DVec3::ZERO, DVec3::Z), f64::INFINITY).map(|h| h.t);
+        assert!((outside.unwrap_or(0.0) - 4.0).abs() < 1e-12);
+        let inside = s.intersect(&Ray::new(s.center, DVec3::X), f64::INFINITY);
+        let inside = inside.map(|h| (h.t, h.geometric_normal));
+        assert!(matches!(inside, Some((t, n)) if (t - 1.0).abs() < 1e-12 && (n - DVec3::X).length() < 1e-12));
+        assert!(s.intersect(&Ray::new(DVec3::ZERO, -DVec3::Z), f64::INFINITY).is_none());
+        assert!(s.intersect(&Ray::new(DVec3::ZERO, DVec3::Z), 3.9).is_none());
+    }
+
+    #[test]
+    fn huge_walls_are_hit_where_they_are() {
+        // smallpt's left wall: centre (1e5 + 1, 40.8, 81.6), radius 1e5, surface at x = 1.
+        let wall = Sphere { center: DVec3::new(1e5 + 1.0, 40.8, 81.6), radius: 1e5 };
+        let ray = Ray::new(DVec3::new(50.0, 40.8, 81.6), -DVec3::X);
+        let hit = wall.intersect(&ray, f64::INFINITY).map(|h| (h.t, h.point.x));
+        assert!(matches!(hit, Some((t, x)) if (t - 49.0).abs() < 1e-9 && (x - 1.0).abs() < 1e-9));
+        // A grazing ray almost parallel to the wall, 10 units off it, misses.
+        let graze = Ray::new(DVec3::new(11.0, 40.8, 81.6), DVec3::new(0.0, 1.0, 0.0));
+        let hit = wall.intersect(&graze, 100.0);
+        assert!(hit.is_none());
+    }
+}

@@ -1,0 +1,43 @@
+//! Integrators: how light transport is estimated. Each one renders
+//! progressive passes into its own state and hands out `Frame`s, so nothing
+//! downstream (viewer, CLI, benchmarks) branches on the algorithm.
+
+pub mod path;
+
+use crate::camera::Camera;
+use crate::film::Frame;
+use crate::render::settings::RenderSettings;
+use crate::scene::Scene;
+use std::sync::atomic::AtomicBool;
+
+/// A progressive renderer of one image.
+pub trait Integrator: Send {
+    /// Adds one pass: one sample per pixel, or one SPPM iteration. Returns
+    /// false if `cancel` was raised before the pass completed (the state is
+    /// then unspecified and the caller starts over).
+    fn render_pass(&mut self, scene: &Scene, camera: &Camera, cancel: &AtomicBool) -> bool;
+
+    /// Completed passes.
+    fn passes(&self) -> u32;
+
+    /// The current estimate.
+    fn frame(&self) -> Frame;
+
+    /// Samples that were NaN or infinite and were dropped (must stay 0).
+    fn rejected_samples(&self) -> u64 {
+        0
+    }
+
+    /// A short status, e.g. the SPPM radius; empty by default.
+    fn status(&self) -> String {
+        String::new()
+    }
+}
+
+/// The integrator the settings ask for.
+pub fn create(settings: &RenderSettings) -> Box<dyn Integrator> {
+    use crate::render::settings::IntegratorKind;
+    match settings.integrator {
+        IntegratorKind::PathTracing | IntegratorKind::BsdfOnly | IntegratorKind::Sppm => Box::new(path::PathIntegrator::new(settings)),
+    }
+}

@@ -1,0 +1,25 @@
+//! Prism: a physically based renderer you watch converge.
+//!
+//! Data flows one way:
+//! scene file → [`scene::description`] (plain data with spans) →
+//! [`scene::Scene`] (shapes, materials, lights, BVH; frozen) →
+//! an [`integrator::Integrator`] (path tracing or SPPM) rendering passes →
+//! [`film::Frame`] → image file ([`output`]), viewer texture or benchmark error.
+//! [`render::render_progressive`] is the one loop the CLI, viewer and
+//! benchmarks share.
+
+#![forbid(unsafe_code)]
+
+pub mod accel;
+pub mod camera;
+pub mod color;
+pub mod film;
+pub mod geometry;
+pub mod integrator;
+pub mod light;
+pub mod material;
+pub mod math;
+pub mod output;
+pub mod render;
+pub mod sampler;
+pub mod scene;

@@ -1,0 +1,211 @@
+//! The `prism` command: subcommands over the library. `anyhow` lives only here.
+
+use anyhow::{Context, Result, bail};
+use clap::{Args, Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+use prism::film::ToneMap;
+use prism::render::{self, IntegratorKind, RenderSettings};
+use prism::sampler::SamplerKind;
+use prism::scene::{self, LoadedScene};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::atomic::AtomicBool;
+use std::time::Duration;
+
+#[derive(Parser)]
+#[command(name = "prism", version, about = "A physically based renderer you watch converge")]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene headless to an image file (PNG, BMP, PPM or EXR).
+    Render(RenderArgs),
+}
+
+#[derive(Args, Debug)]
+struct RenderArgs {
+    /// Scene file (TOML); the embedded default scene if omitted.
+    scene: Option<PathBuf>,
+    /// Output image; the format follows the extension (.png .bmp .ppm .exr).
+    #[arg(short, long, default_value = "prism.png")]
+    output: PathBuf,
+    /// Samples per pixel (path tracing) or iterations (SPPM).
+    #[arg(long, conflicts_with = "time")]
+    spp: Option<u32>,
+    /// Render for this many seconds instead of a sample count.
+    #[arg(long)]
+    time: Option<f64>,
+    #[arg(long)]
+    width: Option<u32>,
+    #[arg(long)]
+    height: Option<u32>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    #[arg(long)]
+    seed: Option<u64>,
+    #[arg(long, value_parser = parse_sampler)]
+    sampler: Option<SamplerKind>,
+    /// pt (NEE + MIS), pt-bsdf (BSDF sampling only) or sppm.
+    #[arg(long, value_parser = parse_integrator)]
+    integrator: Option<IntegratorKind>,
+    /// Maximum number of bounces.
+    #[arg(long)]
+    max_depth: Option<u32>,
+    /// Exposure in stops (display only; EXR output is scaled too).
+    #[arg(long, default_value_t = 0.0)]
+    exposure: f64,
+    /// clamp, reinhard or filmic (8-bit outputs only).
+    #[arg(long, default_value = "clamp", value_parser = parse_tone_map)]
+    tone_map: ToneMap,
+    /// Do not draw a progress bar.
+    #[arg(long)]
+    quiet: bool,
+}
+
+fn parse_sampler(s: &str) -> Result<SamplerKind, String> {
+    match s {
+        "sobol" => Ok(SamplerKind::Sobol),
+        "random" => Ok(SamplerKind::Random),
+        _ => Err("expected sobol or random".into()),
+    }
+}
+
+fn parse_integrator(s: &str) -> Result<IntegratorKind, String> {
+    IntegratorKind::ALL
+        .into_iter()
+        .find(|k| k.name() == s)
+        .ok_or_else(|| "expected pt, pt-bsdf or sppm".into())
+}
+
+fn parse_tone_map(s: &str) -> Result<ToneMap, String> {
+    match s {
+        "clamp" => Ok(ToneMap::Clamp),
+        "reinhard" => Ok(ToneMap::Reinhard),
+        "filmic" => Ok(ToneMap::Filmic),
+        _ => Err("expected clamp, reinhard or filmic".into()),
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Some(Command::Render(args)) => render_command(args),
+        None => match Cli::parse_from(["prism", "render"]).command {
+            Some(Command::Render(args)) => render_command(args),
+            None => Ok(()),
+        },
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("error: {error:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn load(scene: Option<&Path>) -> Result<LoadedScene> {
+    Ok(match scene {
+        Some(path) => scene::load_scene_file(path)?,
+        None => scene::load_scene_str(scene::DEFAULT_SCENE, Path::new("<default scene>"), Path::new("."))?,
+    })
+}
+
+fn apply_overrides(settings: &mut RenderSettings, args: &RenderArgs) -> Result<()> {
+    if let Some(w) = args.width {
+        settings.width = w;
+    }
+    if let Some(h) = args.height {
+        settings.height = h;
+    }
+    if settings.width == 0 || settings.height == 0 {
+        bail!("--width and --height must be at least 1");
+    }
+    if let Some(time) = args.time {
+        if !(time.is_finite() && time > 0.0) {
+            bail!("--time must be a positive number of seconds");
+        }
+        settings.time_limit = Some(Duration::from_secs_f64(time));
+        settings.samples_per_pixel = None;
+    }
+    if let Some(spp) = args.spp {
+        if spp == 0 {
+            bail!("--spp must be at least 1");
+        }
+        settings.samples_per_pixel = Some(spp);
+    }
+    if let Some(depth) = args.max_depth {
+        settings.max_depth = depth;
+    }
+    settings.seed = args.seed.unwrap_or(settings.seed);
+    settings.sampler = args.sampler.unwrap_or(settings.sampler);
+    settings.integrator = args.integrator.unwrap_or(settings.integrator);
+    Ok(())
+}
+
+fn render_command(args: RenderArgs) -> Result<()> {
+    if prism::output::ImageFormat::from_path(&args.output).is_none() {
+        bail!("{}: unsupported image format (use .png, .bmp, .ppm or .exr)", args.output.display());
+    }
+    let loaded = load(args.scene.as_deref())?;
+    let mut settings = loaded.settings.clone();
+    apply_overrides(&mut settings, &args)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.unwrap_or(0))
+        .build()
+        .context("cannot start worker threads")?;
+
+    let bar = progress_bar(&settings, args.quiet);
+    let pixels = settings.pixel_count() as f64;
+    let cancel = AtomicBool::new(false);
+    let integrator = pool.install(|| {
+        render::render_progressive(&loaded.scene, &loaded.camera, &settings, &cancel, |integrator, progress| {
+            let rate = pixels * progress.passes as f64 / progress.elapsed.as_secs_f64().max(1e-9);
+            match settings.time_limit {
+                Some(_) => bar.set_position(progress.elapsed.as_millis() as u64),
+                None => bar.set_position(progress.passes as u64),
+            }
+            let status = integrator.status();
+            bar.set_message(format!("{} passes, {:.2} Msamples/s {status}", progress.passes, rate / 1e6));
+        })
+    });
+    bar.finish_and_clear();
+
+    let frame = integrator.frame();
+    let metadata = vec![
+        ("Software".to_string(), format!("prism {}", env!("CARGO_PKG_VERSION"))),
+        ("Scene".to_string(), args.scene.as_ref().map_or("<default scene>".into(), |p| p.display().to_string())),
+        ("Integrator".to_string(), settings.integrator.to_string()),
+        ("Passes".to_string(), integrator.passes().to_string()),
+        ("Seed".to_string(), settings.seed.to_string()),
+        ("Sampler".to_string(), settings.sampler.to_string()),
+    ];
+    prism::output::save_frame(&frame, &args.output, args.exposure, args.tone_map, &metadata)?;
+    if integrator.rejected_samples() > 0 {
+        eprintln!("warning: {} samples were NaN or infinite and were dropped", integrator.rejected_samples());
+    }
+    if !args.quiet {
+        eprintln!("wrote {} ({}x{}, {} passes of {})", args.output.display(), frame.width, frame.height, integrator.passes(), settings.integrator);
+    }
+    Ok(())
+}
+
+fn progress_bar(settings: &RenderSettings, quiet: bool) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let (length, template) = match (settings.time_limit, settings.samples_per_pixel) {
+        (Some(limit), _) => (limit.as_millis() as u64, "{bar:40} {elapsed_precise} / ETA {eta} {msg}"),
+        (None, Some(spp)) => (spp as u64, "{bar:40} {pos}/{len} spp, ETA {eta} {msg}"),
+        (None, None) => (u64::MAX, "{elapsed_precise} {msg}"),
+    };
+    let bar = ProgressBar::new(length);
+    if let Ok(style) = ProgressStyle::with_template(template) {
+        bar.set_style(style);
+    }
+    bar
+}

@@ -1,0 +1,14 @@
+//! A perfect mirror: reflects everything about the normal, tinted.
+
+use super::{BsdfSample, reflect};
+use crate::color::Color;
+use glam::DVec3;
+
+pub fn sample(tint: Color, wo: DVec3) -> Option<BsdfSample> {
+    (wo.z != 0.0).then(|| BsdfSample {
+        wi: reflect(wo),
+        weight: tint,
+        pdf: 1.0,
+        specular: true,
+    })
+}

@@ -1,0 +1,115 @@
+//! Materials: a closed set of BSDFs dispatched by `match`.
+//!
+//! Conventions (as in pbrt and Nori): `wo` and `wi` are unit vectors in the
+//! local shading frame, both pointing away from the surface; the shading
+//! normal is +z, so `cos θ = w.z`. `eval` returns the BSDF value f(wo, wi)
+//! without the cosine; `sample` returns the Monte Carlo weight
+//! f·|cos θi| / pdf directly, which stays finite for specular lobes.
+
+pub mod dielectric;
+pub mod diffuse;
+pub mod glossy;
+pub mod mirror;
+pub mod texture;
+
+pub use texture::Texture;
+
+use crate::color::Color;
+use glam::{DVec2, DVec3};
+
+/// Which quantity a path carries: radiance from the camera, or importance
+/// (photons) from the lights. Refraction scales them differently (Veach 1997, §5.2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Transport {
+    Radiance,
+    Importance,
+}
+
+/// Where a BSDF is evaluated, for texture lookups.
+#[derive(Clone, Copy, Debug)]
+pub struct ShadingPoint {
+    pub uv: DVec2,
+    pub point: DVec3,
+}
+
+/// A direction drawn from a BSDF.
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSample {
+    pub wi: DVec3,
+    /// f·|cos θi| / pdf.
+    pub weight: Color,
+    /// Density per steradian; for specular lobes the discrete probability of the lobe.
+    pub pdf: f64,
+    pub specular: bool,
+}
+
+#[derive(Clone, Debug)]
+pub enum Material {
+    Diffuse { albedo: Texture },
+    Mirror { tint: Texture },
+    Glass { ior: f64, tint: Color },
+    Glossy { tint: Texture, roughness: f64 },
+    /// A light: emits `radiance` from its front (outward normal) side, or both
+    /// sides when `two_sided`; reflects nothing.
+    Emissive { radiance: Color, two_sided: bool },
+}
+
+impl Material {
+    /// True if every lobe is a delta: light sampling cannot help.
+    pub fn is_specular(&self) -> bool {
+        matches!(self, Material::Mirror { .. } | Material::Glass { .. })
+    }
+
+    /// True if the material scatters light at all.
+    pub fn scatters(&self) -> bool {
+        !matches!(self, Material::Emissive { .. })
+    }
+
+    /// Emitted radiance towards a direction making `cos_theta` with the
+    /// geometric normal.
+    pub fn emitted(&self, cos_theta: f64) -> Color {
+        match self {
+            Material::Emissive { radiance, two_sided } if *two_sided || cos_theta > 0.0 => *radiance,
+            _ => Color::ZERO,
+        }
+    }
+
+    pub fn emission(&self) -> Option<Color> {
+        match self {
+            Material::Emissive { radiance, .. } => Some(*radiance),
+            _ => None,
+        }
+    }
+
+    pub fn eval(&self, wo: DVec3, wi: DVec3, at: &ShadingPoint) -> Color {
+        match self {
+            Material::Diffuse { albedo } => diffuse::eval(albedo.evaluate(at), wo, wi),
+            Material::Glossy { tint, roughness } => glossy::eval(tint.evaluate(at), *roughness, wo, wi),
+            Material::Mirror { .. } | Material::Glass { .. } | Material::Emissive { .. } => Color::ZERO,
+        }
+    }
+
+    pub fn pdf(&self, wo: DVec3, wi: DVec3) -> f64 {
+        match self {
+            Material::Diffuse { .. } => diffuse::pdf(wo, wi),
+            Material::Glossy { roughness, .. } => glossy::pdf(*roughness, wo, wi),
+            Material::Mirror { .. } | Material::Glass { .. } | Material::Emissive { .. } => 0.0,
+        }
+    }
+
+    /// Draws `wi` for the given `wo`; `u` picks the direction, `u_lobe` the lobe.
+    pub fn sample(&self, wo: DVec3, at: &ShadingPoint, u: DVec2, u_lobe: f64, transport: Transport) -> Option<BsdfSample> {
+        match self {
+            Material::Diffuse { albedo } => diffuse::sample(albedo.evaluate(at), wo, u),
+            Material::Glossy { tint, roughness } => glossy::sample(tint.evaluate(at), *roughness, wo, u),
+            Material::Mirror { tint } => mirror::sample(tint.evaluate(at), wo),
+            Material::Glass { ior, tint } => dielectric::sample(*ior, *tint, wo, u_lobe, transport),
+            Material::Emissive { .. } => None,
+        }
+    }
+}
+
+/// Mirror direction about the local normal (+z).
+pub fn reflect(wo: DVec3) -> DVec3 {
+    DVec3::new(-wo.x, -wo.y, wo.z)
+}

@@ -1,0 +1,121 @@
+//! Warps from the unit square to sampling domains, each with its density
+//! (pbrt-v4 appendix A.5, Nori's warp.cpp).
+
+use glam::{DVec2, DVec3};
+use std::f64::consts::{FRAC_1_PI, PI};
+
+/// Uniform point on the unit disk, Shirley–Chiu concentric map (keeps strata).
+pub fn square_to_concentric_disk(u: DVec2) -> DVec2 {
+    let o = 2.0 * u - DVec2::ONE;
+    if o.x == 0.0 && o.y == 0.0 {
+        return DVec2::ZERO;
+    }
+    let (r, theta) = if o.x.abs() > o.y.abs() {
+        (o.x, PI / 4.0 * (o.y / o.x))
+    } else {
+        (o.y, PI / 2.0 - PI / 4.0 * (o.x / o.y))
+    };
+    r * DVec2::new(theta.cos(), theta.sin())
+}
+
+/// Cosine-weighted direction on the +z hemisphere (Malley's method).
+pub fn square_to_cosine_hemisphere(u: DVec2) -> DVec3 {
+    let d = square_to_concentric_disk(u);
+    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
+    DVec3::new(d.x, d.y, z)
+}
+
+/// Density of `square_to_cosine_hemisphere`, per steradian.
+pub fn cosine_hemisphere_pdf(cos_theta: f64) -> f64 {
+    cos_theta.max(0.0) * FRAC_1_PI
+}
+
+/// Uniform direction on the unit sphere.
+pub fn square_to_uniform_sphere(u: DVec2) -> DVec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    DVec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+pub const UNIFORM_SPHERE_PDF: f64 = 1.0 / (4.0 * PI);
+
+/// Uniform direction in the cone of half-angle `acos(cos_theta_max)` around +z.
+pub fn square_to_uniform_cone(u: DVec2, cos_theta_max: f64) -> DVec3 {
+    let cos_theta = 1.0 - u.x * (1.0 - cos_theta_max);
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    DVec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
+}
+
+pub fn uniform_cone_pdf(cos_theta_max: f64) -> f64 {
+    1.0 / (2.0 * PI * (1.0 - cos_theta_max))
+}
+
+/// Barycentric coordinates (b1, b2) uniform over a triangle (Heitz 2019,
+/// "A Low-Distortion Map Between Triangle and Square").
+pub fn square_to_uniform_triangle(u: DVec2) -> DVec2 {
+    if u.y > u.x {
+        let b0 = u.x / 2.0;
+        let b1 = u.y - b0;
+        DVec2::new(b0, b1)
+    } else {
+        let b1 = u.y / 2.0;
+        let b0 = u.x - b1;
+        DVec2::new(b0, b1)
+    }
+}
+
+/// Power heuristic with β = 2 (Veach 1997, eq. 9.13), for the sample drawn
+/// with density `pdf_a` against the competing strategy `pdf_b`.
+pub fn power_heuristic(pdf_a: f64, pdf_b: f64) -> f64 {
+    let a = pdf_a * pdf_a;
+    let b = pdf_b * pdf_b;
+    if a.is_infinite() {
+        return 1.0;
+    }
+    if a + b == 0.0 { 0.0 } else { a / (a + b) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid(n: usize) -> impl Iterator<Item = DVec2> {
+        (0..n * n).map(move |i| DVec2::new(((i % n) as f64 + 0.5) / n as f64, ((i / n) as f64 + 0.5) / n as f64))
+    }
+
+    #[test]
+    fn cosine_hemisphere_integrates_cos_over_pdf_to_pi() {
+        // E[cos / pdf] = π exactly for this density.
+        let n = 64;
+        let mean: f64 = grid(n)
+            .map(|u| {
+                let w = square_to_cosine_hemisphere(u);
+                w.z / cosine_hemisphere_pdf(w.z)
+            })
+            .sum::<f64>()
+            / (n * n) as f64;
+        assert!((mean - PI).abs() < 1e-9);
+    }
+
+    #[test]
+    fn warps_land_in_their_domains() {
+        for u in grid(32) {
+            assert!(square_to_concentric_disk(u).length() <= 1.0 + 1e-12);
+            assert!((square_to_uniform_sphere(u).length() - 1.0).abs() < 1e-12);
+            let c = square_to_uniform_cone(u, 0.9);
+            assert!(c.z >= 0.9 - 1e-12);
+            let b = square_to_uniform_triangle(u);
+            assert!(b.x >= 0.0 && b.y >= 0.0 && b.x + b.y <= 1.0 + 1e-12);
+        }
+    }
+
+    #[test]
+    fn triangle_map_is_uniform_in_the_mean() {
+        // The centroid of a uniform density over the triangle is (1/3, 1/3).
+        let n = 128;
+        let mean = grid(n).map(square_to_uniform_triangle).sum::<DVec2>() / (n * n) as f64;
+        assert!((mean - DVec2::splat(1.0 / 3.0)).length() < 1e-3);
+    }
+}

@@ -1,0 +1,125 @@
+//! Writing frames to image files. Every write goes to a temporary file in
+//! the destination folder and is renamed into place, so a crash or a full
+//! disk never leaves a half-written image under the requested name.
+
+use crate::film::{Frame, ToneMap};
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    #[error("{path}: unsupported image format (use .png, .bmp, .ppm or .exr)")]
+    UnsupportedFormat { path: PathBuf },
+    #[error("{path}: cannot write image: {message}")]
+    Write { path: PathBuf, message: String },
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImageFormat {
+    Png,
+    Bmp,
+    Ppm,
+    Exr,
+}
+
+impl ImageFormat {
+    pub fn from_path(path: &Path) -> Option<Self> {
+        let extension = path.extension()?.to_str()?.to_ascii_lowercase();
+        match extension.as_str() {
+            "png" => Some(Self::Png),
+            "bmp" => Some(Self::Bmp),
+            "ppm" => Some(Self::Ppm),
+            "exr" => Some(Self::Exr),
+            _ => None,
+        }
+    }
+}
+
+/// Saves `frame`: 8-bit sRGB after exposure and tone mapping for PNG, BMP and
+/// PPM; linear 32-bit float for EXR. `metadata` goes into PNG text chunks.
+pub fn save_frame(frame: &Frame, path: &Path, exposure_stops: f64, tone_map: ToneMap, metadata: &[(String, String)]) -> Result<(), OutputError> {
+    let format = ImageFormat::from_path(path).ok_or_else(|| OutputError::UnsupportedFormat { path: path.to_path_buf() })?;
+    let failed = |message: String| OutputError::Write {
+        path: path.to_path_buf(),
+        message,
+    };
+    let directory = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    if !directory.is_dir() {
+        return Err(failed(format!("folder {} does not exist", directory.display())));
+    }
+    let file_name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let temporary = directory.join(format!(".{file_name}.{}.tmp", std::process::id()));
+    let result = write_to(frame, &temporary, format, exposure_stops, tone_map, metadata).and_then(|()| std::fs::rename(&temporary, path).map_err(|e| e.to_string()));
+    if let Err(message) = result {
+        let _ = std::fs::remove_file(&temporary);
+        return Err(failed(message));
+    }
+    Ok(())
+}
+
+fn write_to(frame: &Frame, path: &Path, format: ImageFormat, exposure_stops: f64, tone_map: ToneMap, metadata: &[(String, String)]) -> Result<(), String> {
+    let (width, height) = (frame.width, frame.height);
+    match format {
+        ImageFormat::Exr => {
+            let scale = exposure_stops.exp2() as f32;
+            let data: Vec<f32> = frame.pixels.iter().flat_map(|p| p.map(|c| c * scale)).collect();
+            let buffer = image::Rgb32FImage::from_raw(width, height, data).ok_or("frame size mismatch")?;
+            image::DynamicImage::ImageRgb32F(buffer)
+                .save_with_format(path, image::ImageFormat::OpenExr)
+                .map_err(|e| e.to_string())
+        }
+        ImageFormat::Png => {
+            let data: Vec<u8> = frame.to_srgb8(exposure_stops, tone_map).into_iter().flatten().collect();
+            let file = File::create(path).map_err(|e| e.to_string())?;
+            let mut encoder = png::Encoder::new(BufWriter::new(file), width, height);
+            encoder.set_color(png::ColorType::Rgb);
+            encoder.set_depth(png::BitDepth::Eight);
+            encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+            for (key, value) in metadata {
+                encoder.add_text_chunk(key.clone(), value.clone()).map_err(|e| e.to_string())?;
+            }
+            let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+            writer.write_image_data(&data).map_err(|e| e.to_string())?;
+            writer.finish().map_err(|e| e.to_string())
+        }
+        ImageFormat::Bmp | ImageFormat::Ppm => {
+            let data: Vec<u8> = frame.to_srgb8(exposure_stops, tone_map).into_iter().flatten().collect();
+            let buffer = image::RgbImage::from_raw(width, height, data).ok_or("frame size mismatch")?;
+            let format = if format == ImageFormat::Bmp { image::ImageFormat::Bmp } else { image::ImageFormat::Pnm };
+            let mut writer = BufWriter::new(File::create(path).map_err(|e| e.to_string())?);
+            let mut bytes = std::io::Cursor::new(Vec::new());
+            buffer.write_to(&mut bytes, format).map_err(|e| e.to_string())?;
+            writer.write_all(bytes.get_ref()).map_err(|e| e.to_string())?;
+            writer.flush().map_err(|e| e.to_string())
+        }
+    }
+}
+
+/// Reads an image file back as a linear frame (EXR stays linear; 8-bit
+/// formats are sRGB-decoded). Used by benchmarks and tests.
+pub fn load_frame(path: &Path) -> Result<Frame, String> {
+    let image = image::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let is_float = matches!(image, image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_));
+    let rgb = image.to_rgb32f();
+    let (width, height) = rgb.dimensions();
+    let pixels = rgb
+        .pixels()
+        .map(|p| {
+            if is_float {
+                p.0
+            } else {
+                p.0.map(|c| crate::color::srgb_decode(c as f64) as f32)
+            }
+        })
+        .collect();
+    Ok(Frame {
+        width,
+        height,
+        pixels,
+        noise: Vec::new(),
+    })
+}
