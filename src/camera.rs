@@ -15,6 +15,9 @@ pub struct Camera {
     pub aperture_radius: f64,
     /// Distance from the lens to the plane in focus, along the view axis.
     pub focal_distance: f64,
+    /// Rays start on the plane this far along the view axis, so geometry in
+    /// front of it is invisible (smallpt's camera sits behind a wall this way).
+    pub near_clip: f64,
     basis: Basis,
 }
 
@@ -35,6 +38,7 @@ impl Camera {
             fov_y_degrees,
             aperture_radius,
             focal_distance,
+            near_clip: 0.0,
             basis: Basis {
                 right: DVec3::X,
                 up: DVec3::Y,
@@ -82,13 +86,18 @@ impl Camera {
         // Direction with unit forward component: `focal_distance` along it
         // lands on the focal plane.
         let direction = b.forward + x * b.right + y * b.up;
-        if self.aperture_radius <= 0.0 {
-            return Ray::new(self.position, direction);
+        let mut ray = if self.aperture_radius <= 0.0 {
+            Ray::new(self.position, direction)
+        } else {
+            let focus = self.position + self.focal_distance * direction;
+            let disk = warp::square_to_concentric_disk(lens) * self.aperture_radius;
+            let origin = self.position + disk.x * b.right + disk.y * b.up;
+            Ray::new(origin, focus - origin)
+        };
+        if self.near_clip > 0.0 {
+            ray.origin += ray.direction * (self.near_clip / ray.direction.dot(b.forward));
         }
-        let focus = self.position + self.focal_distance * direction;
-        let disk = warp::square_to_concentric_disk(lens) * self.aperture_radius;
-        let origin = self.position + disk.x * b.right + disk.y * b.up;
-        Ray::new(origin, focus - origin)
+        ray
     }
 
     /// Depth of a world point along the view axis: what the focal distance

@@ -37,6 +37,9 @@ pub struct CameraDescription {
     pub aperture_radius: f64,
     /// Distance to the plane in focus; default the distance to `look_at`.
     pub focal_distance: Option<f64>,
+    /// Rays start this far along the view axis (default 0).
+    #[serde(default)]
+    pub near_clip: f64,
 }
 
 fn default_up() -> Vector {
@@ -60,6 +63,8 @@ pub struct RenderDescription {
     pub photons_per_iteration: Option<u32>,
     pub initial_radius: Option<f64>,
     pub alpha: Option<f64>,
+    /// Relative standard error at which a pixel stops taking samples.
+    pub adaptive_threshold: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]

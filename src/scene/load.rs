@@ -149,7 +149,13 @@ impl Builder<'_> {
             Some(f) => f,
             None => (look_at - position).length(),
         };
-        Ok(Camera::new(position, look_at, up, c.fov_y_degrees, c.aperture_radius, focal_distance))
+        self.finite(&span, p, "near_clip", &[c.near_clip])?;
+        if c.near_clip < 0.0 {
+            return Err(self.error(span, p, "near_clip", "must not be negative"));
+        }
+        let mut camera = Camera::new(position, look_at, up, c.fov_y_degrees, c.aperture_radius, focal_distance);
+        camera.near_clip = c.near_clip;
+        Ok(camera)
     }
 
     fn settings(&self, r: &RenderDescription) -> Result<RenderSettings, SceneError> {
@@ -186,6 +192,12 @@ impl Builder<'_> {
                 return Err(self.error(span, p, "alpha", "must be strictly between 0 and 1"));
             }
             s.sppm.alpha = alpha;
+        }
+        if let Some(threshold) = r.adaptive_threshold {
+            if !(threshold.is_finite() && threshold > 0.0) {
+                return Err(self.error(span, p, "adaptive_threshold", "must be a positive finite number"));
+            }
+            s.adaptive_threshold = Some(threshold);
         }
         s.integrator = r.integrator.unwrap_or(s.integrator);
         s.sampler = r.sampler.unwrap_or(s.sampler);
