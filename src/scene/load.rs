@@ -7,13 +7,16 @@ use super::{Primitive, Scene};
 use crate::camera::Camera;
 use crate::color::Color;
 use crate::geometry::{AxisBox, Mesh, Quad, Shape, Sphere, Transform};
-use crate::material::{Material, Texture};
+use crate::material::Material;
+use crate::material::texture::ImageCache;
 use crate::math::Aabb;
 use crate::render::settings::RenderSettings;
 use glam::DVec3;
 use std::collections::HashMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
+
+mod texture;
 
 /// A scene ready to render, with the camera and settings its file asked for.
 #[derive(Debug)]
@@ -37,8 +40,17 @@ pub fn load_scene_file(path: &Path) -> Result<LoadedScene, SceneError> {
 /// Builds a scene from TOML text; `file` names it in errors, `base` resolves paths.
 pub fn load_scene_str(text: &str, file: &Path, base: &Path) -> Result<LoadedScene, SceneError> {
     let description: SceneDescription = toml::from_str(text).map_err(|e| {
-        let line = e.span().map(|s| line_of(text, s.start));
-        SceneError::new(file, line, None, e.message().to_string())
+        let message = e.message().to_string();
+        let line = e.span().map(|span| {
+            // Tagged tables report errors at their start; point at the
+            // offending key itself when the message names it.
+            let key = message.strip_prefix("unknown field `").and_then(|rest| rest.split('`').next());
+            let start = span.start.min(text.len());
+            let next_header = text[start + 1.min(text.len() - start)..].find("\n[").map_or(text.len(), |i| start + 1 + i);
+            let offset = key.and_then(|k| find_key(&text[start..next_header.max(start)], k)).unwrap_or(0);
+            line_of(text, start + offset)
+        });
+        SceneError::new(file, line, None, message)
     })?;
     Builder { text, file, base }.build(description)
 }
@@ -54,9 +66,13 @@ impl Builder<'_> {
     /// that key is written (or where the table starts).
     fn error(&self, span: Option<Range<usize>>, path: &str, field: &str, message: impl Into<String>) -> SceneError {
         let line = span.map(|span| {
-            let body = &self.text[span.start.min(self.text.len())..span.end.min(self.text.len())];
-            let key_offset = find_key(body, field).unwrap_or(0);
-            line_of(self.text, span.start + key_offset)
+            // A `[[table]]`'s span may cover only its header: search on to the
+            // next header as well.
+            let start = span.start.min(self.text.len());
+            let next_header = self.text[start..].find("\n[").map_or(self.text.len(), |i| start + i);
+            let end = span.end.min(self.text.len()).max(next_header);
+            let key_offset = find_key(&self.text[start..end], field).unwrap_or(0);
+            line_of(self.text, start + key_offset)
         });
         let full = if path.is_empty() { field.to_string() } else { format!("{path}.{field}") };
         SceneError::new(self.file, line, Some(full), message)
@@ -85,10 +101,12 @@ impl Builder<'_> {
         // Materials, by name.
         let mut material_index = HashMap::new();
         let mut materials = Vec::new();
+        // Each image file is decoded once, however many materials use it.
+        let mut images = ImageCache::default();
         for (name, spanned) in &description.materials {
             let span = Some(spanned.span());
             let path = format!("materials.{name}");
-            materials.push(self.material(&span, &path, spanned.get_ref())?);
+            materials.push(self.material(&span, &path, spanned.get_ref(), &mut images)?);
             material_index.insert(name.as_str(), (materials.len() - 1) as u32);
         }
 
@@ -205,19 +223,19 @@ impl Builder<'_> {
         Ok(s)
     }
 
-    fn material(&self, span: &Option<Range<usize>>, path: &str, m: &MaterialDescription) -> Result<Material, SceneError> {
+    fn material(
+        &self,
+        span: &Option<Range<usize>>,
+        path: &str,
+        m: &MaterialDescription,
+        images: &mut ImageCache,
+    ) -> Result<Material, SceneError> {
         Ok(match m {
-            MaterialDescription::Diffuse { albedo } => {
-                let albedo = self.color(span, path, "albedo", *albedo)?;
-                if albedo.max_element() > 1.0 {
-                    return Err(self.error(span.clone(), path, "albedo", "must not exceed 1 (it would create energy)"));
-                }
-                Material::Diffuse {
-                    albedo: Texture::Constant(albedo),
-                }
-            }
+            MaterialDescription::Diffuse { albedo } => Material::Diffuse {
+                albedo: self.texture(span, path, "albedo", albedo, true, images)?,
+            },
             MaterialDescription::Mirror { tint } => Material::Mirror {
-                tint: Texture::Constant(self.color(span, path, "tint", *tint)?),
+                tint: self.texture(span, path, "tint", tint, false, images)?,
             },
             MaterialDescription::Glass { ior, tint } => {
                 self.finite(span, path, "ior", &[*ior])?;
@@ -235,7 +253,7 @@ impl Builder<'_> {
                     return Err(self.error(span.clone(), path, "roughness", "must be between 0 and 1"));
                 }
                 Material::Glossy {
-                    tint: Texture::Constant(self.color(span, path, "tint", *tint)?),
+                    tint: self.texture(span, path, "tint", tint, false, images)?,
                     roughness: *roughness,
                 }
             }

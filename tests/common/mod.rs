@@ -1,0 +1,94 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use prism::film::Frame;
+use prism::render::{IntegratorKind, RenderSettings, render_with_threads};
+use prism::sampler::SamplerKind;
+use prism::scene::{LoadedScene, load_scene_str};
+use std::path::Path;
+
+pub fn scene(text: &str) -> LoadedScene {
+    match load_scene_str(text, Path::new("test.toml"), Path::new(env!("CARGO_MANIFEST_DIR"))) {
+        Ok(s) => s,
+        Err(e) => panic!("test scene does not load: {e}"),
+    }
+}
+
+pub fn shipped_scene(name: &str) -> LoadedScene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(name);
+    match prism::scene::load_scene_file(&path) {
+        Ok(s) => s,
+        Err(e) => panic!("{e}"),
+    }
+}
+
+pub struct Job {
+    pub width: u32,
+    pub height: u32,
+    pub spp: u32,
+    pub integrator: IntegratorKind,
+    pub sampler: SamplerKind,
+    pub seed: u64,
+    pub max_depth: u32,
+    pub threads: Option<usize>,
+}
+
+impl Default for Job {
+    fn default() -> Self {
+        Self {
+            width: 32,
+            height: 32,
+            spp: 16,
+            integrator: IntegratorKind::PathTracing,
+            sampler: SamplerKind::Sobol,
+            seed: 1,
+            max_depth: 64,
+            threads: None,
+        }
+    }
+}
+
+pub fn render(loaded: &LoadedScene, job: &Job) -> Frame {
+    let settings = RenderSettings {
+        width: job.width,
+        height: job.height,
+        samples_per_pixel: Some(job.spp),
+        time_limit: None,
+        max_depth: job.max_depth,
+        integrator: job.integrator,
+        sampler: job.sampler,
+        seed: job.seed,
+        ..loaded.settings.clone()
+    };
+    match render_with_threads(&loaded.scene, &loaded.camera, &settings, job.threads) {
+        Ok(integrator) => {
+            assert_eq!(integrator.rejected_samples(), 0, "NaN or infinite samples");
+            integrator.frame()
+        }
+        Err(e) => panic!("{e}"),
+    }
+}
+
+/// Mean and standard error of the per-channel image mean over independent
+/// renders with seeds 1..=runs.
+pub fn mean_and_error(loaded: &LoadedScene, job: &Job, runs: u64) -> ([f64; 3], [f64; 3]) {
+    let means: Vec<[f64; 3]> = (1..=runs)
+        .map(|seed| render(loaded, &Job { seed, ..*job }).channel_means())
+        .collect();
+    let n = runs as f64;
+    let mut mean = [0.0; 3];
+    let mut error = [0.0; 3];
+    for c in 0..3 {
+        mean[c] = means.iter().map(|m| m[c]).sum::<f64>() / n;
+        let variance = means.iter().map(|m| (m[c] - mean[c]).powi(2)).sum::<f64>() / (n - 1.0);
+        error[c] = (variance / n).sqrt();
+    }
+    (mean, error)
+}
+
+impl Clone for Job {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl Copy for Job {}

@@ -1,0 +1,104 @@
+//! Physics checks run through the whole renderer: furnaces whose answer is
+//! known exactly, and estimators that must agree in the mean.
+
+mod common;
+use common::{Job, mean_and_error, render, scene, shipped_scene};
+use prism::render::IntegratorKind;
+
+/// A uniformly emitting enclosure (radiance 1, seen from inside, so two-sided)
+/// around `inner` objects; the camera sits inside looking at the origin.
+fn furnace(materials: &str, objects: &str) -> String {
+    format!(
+        r#"
+[camera]
+position = [0, 0, 8]
+look_at = [0, 0, 0]
+fov_y_degrees = 50
+
+[materials.sky]
+type = "emissive"
+radiance = [1, 1, 1]
+two_sided = true
+{materials}
+
+[[objects]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 20
+material = "sky"
+{objects}
+"#
+    )
+}
+
+/// White furnace (Nori's test): a diffuse sphere of albedo 1 inside a uniform
+/// emitter of radiance 1 reflects exactly radiance 1, so every pixel's
+/// expected value is 1. Tolerance 0.5% on the image mean, as the issue asks;
+/// at 32×32×64 samples the standard error of the NEE estimate is below 0.1%.
+#[test]
+fn white_furnace_is_one_with_light_sampling_and_without() {
+    let loaded = scene(&furnace(
+        "[materials.white]\ntype = \"diffuse\"\nalbedo = [1, 1, 1]",
+        "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 3\nmaterial = \"white\"",
+    ));
+    for integrator in [IntegratorKind::PathTracing, IntegratorKind::BsdfOnly] {
+        let frame = render(&loaded, &Job { spp: 64, integrator, ..Job::default() });
+        for (c, mean) in frame.channel_means().into_iter().enumerate() {
+            assert!((mean - 1.0).abs() < 0.005, "{integrator}: channel {c} mean {mean}");
+        }
+    }
+}
+
+/// A glass sphere without absorption in the same furnace: every path leaves
+/// the glass eventually and sees radiance 1; the 1/η² radiance scaling on
+/// entry is undone on exit. Tolerance: 1% on the image mean, over 3 standard
+/// errors measured from 6 independent runs (truncation at depth 64 removes
+/// well under 0.1% at these Fresnel weights).
+#[test]
+fn glass_neither_gains_nor_loses_energy() {
+    let loaded = scene(&furnace(
+        "[materials.glass]\ntype = \"glass\"\nior = 1.5",
+        "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 3\nmaterial = \"glass\"",
+    ));
+    let (mean, error) = mean_and_error(&loaded, &Job { spp: 16, ..Job::default() }, 6);
+    for c in 0..3 {
+        assert!(3.0 * error[c] < 0.01, "estimate too noisy to test: {error:?}");
+        assert!((mean[c] - 1.0).abs() < 0.01, "channel {c}: mean {} ± {}", mean[c], error[c]);
+    }
+}
+
+/// Next-event estimation with MIS and pure BSDF sampling estimate the same
+/// integral: on the Cornell box their per-channel image means must agree
+/// within three combined standard errors (each from 8 independent runs).
+#[test]
+fn light_sampling_and_bsdf_sampling_agree_on_cornell() {
+    let loaded = shipped_scene("cornell.toml");
+    let job = Job { width: 24, height: 24, spp: 32, max_depth: 32, ..Job::default() };
+    let (nee, nee_error) = mean_and_error(&loaded, &Job { integrator: IntegratorKind::PathTracing, ..job }, 8);
+    let (bsdf, bsdf_error) = mean_and_error(&loaded, &Job { integrator: IntegratorKind::BsdfOnly, ..job }, 8);
+    for c in 0..3 {
+        let combined = (nee_error[c].powi(2) + bsdf_error[c].powi(2)).sqrt();
+        assert!(
+            (nee[c] - bsdf[c]).abs() < 3.0 * combined,
+            "channel {c}: NEE {} ± {}, BSDF {} ± {}",
+            nee[c],
+            nee_error[c],
+            bsdf[c],
+            bsdf_error[c]
+        );
+        // The comparison must have teeth: both means are well above zero
+        // and the errors small relative to them.
+        assert!(nee[c] > 0.01 && combined < 0.1 * nee[c], "channel {c}: {nee:?} ± {combined}");
+    }
+}
+
+/// Light sampling must lower variance where it should: on the Cornell box
+/// the NEE estimate's spread over runs is smaller than BSDF-only's.
+#[test]
+fn light_sampling_reduces_variance() {
+    let loaded = shipped_scene("cornell.toml");
+    let job = Job { width: 16, height: 16, spp: 8, max_depth: 16, ..Job::default() };
+    let (_, nee_error) = mean_and_error(&loaded, &Job { integrator: IntegratorKind::PathTracing, ..job }, 6);
+    let (_, bsdf_error) = mean_and_error(&loaded, &Job { integrator: IntegratorKind::BsdfOnly, ..job }, 6);
+    assert!(nee_error[1] < bsdf_error[1], "NEE {nee_error:?} vs BSDF {bsdf_error:?}");
+}
