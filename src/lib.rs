@@ -11,6 +11,7 @@
 #![forbid(unsafe_code)]
 
 pub mod accel;
+pub mod bench;
 pub mod camera;
 pub mod color;
 pub mod film;
@@ -19,7 +20,9 @@ pub mod integrator;
 pub mod light;
 pub mod material;
 pub mod math;
+pub mod metrics;
 pub mod output;
 pub mod render;
 pub mod sampler;
 pub mod scene;
+pub mod viewer;

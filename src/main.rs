@@ -1,5 +1,7 @@
 //! The `prism` command: subcommands over the library. `anyhow` lives only here.
 
+mod bench_command;
+
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -23,6 +25,13 @@ struct Cli {
 enum Command {
     /// Render a scene headless to an image file (PNG, BMP, PPM or EXR).
     Render(RenderArgs),
+    /// Measure error against time, scaling, or numerical stress (see docs/benchmarks.md).
+    Bench(bench_command::BenchArgs),
+    /// Open the interactive viewer on a scene (the default scene if omitted).
+    View {
+        /// Scene file (TOML).
+        scene: Option<PathBuf>,
+    },
 }
 
 #[derive(Args, Debug)]
@@ -33,7 +42,7 @@ struct RenderArgs {
     #[arg(short, long, default_value = "prism.png")]
     output: PathBuf,
     /// Samples per pixel (path tracing) or iterations (SPPM).
-    #[arg(long, conflicts_with = "time")]
+    #[arg(long, conflicts_with = "time", visible_alias = "iterations")]
     spp: Option<u32>,
     /// Render for this many seconds instead of a sample count.
     #[arg(long)]
@@ -55,6 +64,19 @@ struct RenderArgs {
     /// Maximum number of bounces.
     #[arg(long)]
     max_depth: Option<u32>,
+    /// Adaptive sampling: stop sampling a pixel once its standard error /
+    /// max(mean luminance, 0.01) is below this (e.g. 0.02).
+    #[arg(long)]
+    adaptive_threshold: Option<f64>,
+    /// SPPM: photons traced per iteration.
+    #[arg(long)]
+    photons: Option<u32>,
+    /// SPPM: initial gather radius in scene units (default: from the pixel footprint).
+    #[arg(long)]
+    radius: Option<f64>,
+    /// SPPM: fraction of each iteration's photons kept, in (0, 1) (default 2/3).
+    #[arg(long)]
+    alpha: Option<f64>,
     /// Exposure in stops (display only; EXR output is scaled too).
     #[arg(long, default_value_t = 0.0)]
     exposure: f64,
@@ -94,10 +116,9 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Render(args)) => render_command(args),
-        None => match Cli::parse_from(["prism", "render"]).command {
-            Some(Command::Render(args)) => render_command(args),
-            None => Ok(()),
-        },
+        Some(Command::Bench(args)) => bench_command::bench_command(args),
+        Some(Command::View { scene }) => view_command(scene),
+        None => view_command(None),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -106,6 +127,16 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// Opens the viewer; without a display it says how to render headless instead.
+fn view_command(scene: Option<PathBuf>) -> Result<()> {
+    let start = prism::viewer::ViewerStart {
+        scene,
+        ..Default::default()
+    };
+    prism::viewer::run(start)?;
+    Ok(())
 }
 
 fn load(scene: Option<&Path>) -> Result<LoadedScene> {
@@ -144,6 +175,30 @@ fn apply_overrides(settings: &mut RenderSettings, args: &RenderArgs) -> Result<(
     settings.seed = args.seed.unwrap_or(settings.seed);
     settings.sampler = args.sampler.unwrap_or(settings.sampler);
     settings.integrator = args.integrator.unwrap_or(settings.integrator);
+    if let Some(threshold) = args.adaptive_threshold {
+        if !(threshold.is_finite() && threshold > 0.0) {
+            bail!("--adaptive-threshold must be a positive number");
+        }
+        settings.adaptive_threshold = Some(threshold);
+    }
+    if let Some(photons) = args.photons {
+        if photons == 0 {
+            bail!("--photons must be at least 1");
+        }
+        settings.sppm.photons_per_iteration = photons;
+    }
+    if let Some(radius) = args.radius {
+        if !(radius.is_finite() && radius > 0.0) {
+            bail!("--radius must be a positive number");
+        }
+        settings.sppm.initial_radius = Some(radius);
+    }
+    if let Some(alpha) = args.alpha {
+        if !(alpha > 0.0 && alpha < 1.0) {
+            bail!("--alpha must be strictly between 0 and 1");
+        }
+        settings.sppm.alpha = alpha;
+    }
     Ok(())
 }
 

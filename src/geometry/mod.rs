@@ -3,9 +3,11 @@
 //! nearest hit (distance, normals, uv), bounds, area, and uniform area sampling.
 
 pub mod axis_box;
+pub mod bezier;
 pub mod hit;
 pub mod mesh;
 pub mod quad;
+pub mod revolution;
 pub mod sphere;
 pub mod transform;
 pub mod triangle;
@@ -14,6 +16,7 @@ pub use axis_box::AxisBox;
 pub use hit::{AreaSample, SurfaceHit};
 pub use mesh::Mesh;
 pub use quad::Quad;
+pub use revolution::Revolution;
 pub use sphere::Sphere;
 pub use transform::Transform;
 pub use triangle::Triangle;
@@ -28,6 +31,8 @@ pub enum Shape {
     Triangle(Triangle),
     AxisBox(AxisBox),
     Quad(Quad),
+    /// Boxed: it carries its profile and sampling tables.
+    Revolution(Box<Revolution>),
 }
 
 impl Shape {
@@ -37,6 +42,7 @@ impl Shape {
             Shape::Triangle(t) => t.bounds(),
             Shape::AxisBox(b) => b.bounds,
             Shape::Quad(q) => q.bounds(),
+            Shape::Revolution(r) => r.bounds(),
         }
     }
 
@@ -46,6 +52,7 @@ impl Shape {
             Shape::Triangle(t) => t.area(),
             Shape::AxisBox(b) => b.area(),
             Shape::Quad(q) => q.area(),
+            Shape::Revolution(r) => r.area(),
         }
     }
 
@@ -60,6 +67,7 @@ impl Shape {
             }
             Shape::AxisBox(b) => b.intersect(ray, t_max),
             Shape::Quad(q) => q.intersect(ray, t_max),
+            Shape::Revolution(r) => r.intersect(ray, t_max),
         }
     }
 
@@ -71,6 +79,7 @@ impl Shape {
             Shape::Sphere(s) => s.intersect(ray, t_max).map(|h| h.t),
             Shape::AxisBox(b) => b.intersect(ray, t_max).map(|h| h.t),
             Shape::Quad(q) => q.intersect(ray, t_max).map(|h| h.t),
+            Shape::Revolution(r) => r.intersect(ray, t_max).map(|h| h.t),
         }
     }
 
@@ -81,6 +90,7 @@ impl Shape {
             Shape::Triangle(t) => t.sample_area(u),
             Shape::AxisBox(b) => b.sample_area(u),
             Shape::Quad(q) => q.sample_area(u),
+            Shape::Revolution(r) => r.sample_area(u),
         }
     }
 }

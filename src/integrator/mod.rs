@@ -3,6 +3,7 @@
 //! downstream (viewer, CLI, benchmarks) branches on the algorithm.
 
 pub mod path;
+pub mod sppm;
 
 use crate::camera::Camera;
 use crate::film::Frame;
@@ -38,6 +39,7 @@ pub trait Integrator: Send {
 pub fn create(settings: &RenderSettings) -> Box<dyn Integrator> {
     use crate::render::settings::IntegratorKind;
     match settings.integrator {
-        IntegratorKind::PathTracing | IntegratorKind::BsdfOnly | IntegratorKind::Sppm => Box::new(path::PathIntegrator::new(settings)),
+        IntegratorKind::PathTracing | IntegratorKind::BsdfOnly => Box::new(path::PathIntegrator::new(settings)),
+        IntegratorKind::Sppm => Box::new(sppm::SppmIntegrator::new(settings)),
     }
 }

@@ -130,6 +130,7 @@ pub struct PathIntegrator {
     seed: u64,
     film: Film,
     passes: u32,
+    adaptive_threshold: Option<f64>,
 }
 
 impl PathIntegrator {
@@ -140,6 +141,7 @@ impl PathIntegrator {
             seed: settings.seed,
             film: Film::new(settings.width, settings.height),
             passes: 0,
+            adaptive_threshold: settings.adaptive_threshold,
         }
     }
 
@@ -162,7 +164,7 @@ impl Integrator for PathIntegrator {
         let sample_index = self.passes;
         let (tracer, kind, seed) = (self.tracer, self.sampler, self.seed);
         let size = (self.film.width, self.film.height);
-        let completed = pass::add_samples(&mut self.film, cancel, |x, y| {
+        let completed = pass::add_samples_adaptive(&mut self.film, cancel, self.adaptive_threshold, |x, y| {
             let mut sampler = Sampler::new(kind, y as u64 * size.0 as u64 + x as u64, sample_index, seed);
             let ray = camera_ray(camera, size, x, y, &mut sampler);
             tracer.radiance(scene, ray, &mut sampler)
@@ -183,5 +185,16 @@ impl Integrator for PathIntegrator {
 
     fn rejected_samples(&self) -> u64 {
         self.film.rejected_samples
+    }
+
+    fn status(&self) -> String {
+        match self.adaptive_threshold {
+            Some(threshold) => {
+                let converged = self.film.pixels.iter().filter(|p| pass::is_converged(p, threshold)).count();
+                let active = 100.0 * (1.0 - converged as f64 / self.film.pixels.len().max(1) as f64);
+                format!("adaptive: {active:.0}% of pixels active")
+            }
+            None => String::new(),
+        }
     }
 }

@@ -2,6 +2,7 @@
 //! progressive driver that the CLI, the viewer and the benchmarks all use.
 
 pub mod pass;
+pub mod session;
 pub mod settings;
 
 pub use settings::{IntegratorKind, RenderSettings, SppmSettings};

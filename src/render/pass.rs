@@ -1,14 +1,63 @@
 //! The one parallel pixel loop every per-pixel integrator shares: rows are
 //! handed to rayon's workers, each owns its pixels (no locks), and the
 //! cancel flag is checked once per row.
+//!
+//! Adaptive sampling skips pixels whose estimate is already good enough. A
+//! pixel's activity is decided only from its own accumulated state at the
+//! start of a pass, so the image stays a pure function of the seed whatever
+//! the thread count; and since a stopped pixel's state no longer changes, it
+//! stays stopped, so each pixel's samples are a prefix of its sequence.
 
-use crate::color::Color;
+use crate::color::{Color, luminance};
 use crate::film::{Film, PixelAccumulator};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
+/// Samples a pixel takes before adaptive sampling may stop it: a variance
+/// estimated from fewer is itself too noisy to trust (a pixel whose first few
+/// paths all missed a small light would look converged), and 32 is a power of
+/// two, where a pixel's Sobol' prefix is a complete (0, m, 2)-net.
+pub const ADAPTIVE_MIN_SAMPLES: u32 = 32;
+
+/// Luminance below which the adaptive error is measured absolutely rather than
+/// relatively: 1% of display white, so near-black pixels need not reach a
+/// relative error their tone-mapped value could never show.
+pub const ADAPTIVE_LUMINANCE_FLOOR: f64 = 0.01;
+
+/// Whether adaptive sampling with `threshold` stops this pixel: standard error
+/// of its mean luminance / max(mean luminance, floor) ≤ threshold.
+#[inline]
+pub fn is_converged(pixel: &PixelAccumulator, threshold: f64) -> bool {
+    if pixel.count < ADAPTIVE_MIN_SAMPLES {
+        return false;
+    }
+    let mean = luminance(pixel.sum) / pixel.count as f64;
+    pixel.standard_error() <= threshold * mean.max(ADAPTIVE_LUMINANCE_FLOOR)
+}
+
 /// Adds one sample to every pixel: `sample(x, y)`. Returns false if cancelled.
 pub fn add_samples(film: &mut Film, cancel: &AtomicBool, sample: impl Fn(u32, u32) -> Color + Sync) -> bool {
+    // `|_| true` is inlined away: the non-adaptive loop costs what it did.
+    add_samples_where(film, cancel, |_| true, sample)
+}
+
+/// Adds one sample to each pixel that adaptive sampling with `threshold`
+/// has not stopped (see [`is_converged`]); `None` samples every pixel.
+pub fn add_samples_adaptive(film: &mut Film, cancel: &AtomicBool, threshold: Option<f64>, sample: impl Fn(u32, u32) -> Color + Sync) -> bool {
+    match threshold {
+        Some(threshold) => add_samples_where(film, cancel, |pixel| !is_converged(pixel, threshold), sample),
+        None => add_samples(film, cancel, sample),
+    }
+}
+
+/// Adds one sample to each pixel for which `active(pixel)` holds, judged on
+/// the pixel's state before this pass. Returns false if cancelled.
+pub fn add_samples_where(
+    film: &mut Film,
+    cancel: &AtomicBool,
+    active: impl Fn(&PixelAccumulator) -> bool + Sync,
+    sample: impl Fn(u32, u32) -> Color + Sync,
+) -> bool {
     let width = film.width as usize;
     let rejected = AtomicU64::new(0);
     film.pixels.par_chunks_mut(width).enumerate().for_each(|(y, row)| {
@@ -17,6 +66,9 @@ pub fn add_samples(film: &mut Film, cancel: &AtomicBool, sample: impl Fn(u32, u3
         }
         let mut row_rejected = 0;
         for (x, pixel) in row.iter_mut().enumerate() {
+            if !active(pixel) {
+                continue;
+            }
             let value = sample(x as u32, y as u32);
             add_finite(pixel, value, &mut row_rejected);
         }
@@ -34,5 +86,55 @@ fn add_finite(pixel: &mut PixelAccumulator, value: Color, rejected: &mut u64) {
         pixel.add(value);
     } else {
         *rejected += 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::{RenderSettings, render_with_threads};
+    use crate::scene::{DEFAULT_SCENE, load_scene_str};
+    use std::path::Path;
+
+    /// A pixel whose samples never vary converges exactly at the minimum
+    /// count; one whose samples alternate 0 / 2 (relative error 1/√n) stays
+    /// active until 1/√n ≤ threshold.
+    #[test]
+    fn adaptive_sampling_stops_only_converged_pixels() {
+        let mut film = Film::new(2, 1);
+        let cancel = AtomicBool::new(false);
+        let threshold = 0.1;
+        for pass in 0..200u32 {
+            add_samples_adaptive(&mut film, &cancel, Some(threshold), |x, _| {
+                if x == 0 { Color::splat(0.5) } else { Color::splat(2.0 * (pass % 2) as f64) }
+            });
+        }
+        assert_eq!(film.pixels[0].count, ADAPTIVE_MIN_SAMPLES);
+        // After an even n of alternating 0/2 samples the mean is 1 and the
+        // standard error 1/√(n−1), ≤ 0.1 first at n = 102; at odd n = 101 the
+        // mean is 100/101 and the error 0.099995 > 0.1 · 100/101. Exact count.
+        let stopped = film.pixels[1].count;
+        assert_eq!(stopped, 102, "noisy pixel stopped after {stopped} samples");
+        assert!(is_converged(&film.pixels[1], threshold));
+    }
+
+    /// Same seed, same image, with 1 or 2 threads, adaptive sampling on: a
+    /// pixel's activity depends only on its own samples. Exact equality: any
+    /// dependence on scheduling would change some pixel's sample count.
+    #[test]
+    fn adaptive_images_do_not_depend_on_thread_count() {
+        let loaded = load_scene_str(DEFAULT_SCENE, Path::new("cornell"), Path::new(".")).expect("default scene loads");
+        let settings = RenderSettings {
+            width: 12,
+            height: 12,
+            samples_per_pixel: Some(48),
+            adaptive_threshold: Some(0.3),
+            ..loaded.settings.clone()
+        };
+        let one = render_with_threads(&loaded.scene, &loaded.camera, &settings, Some(1)).expect("pool");
+        let two = render_with_threads(&loaded.scene, &loaded.camera, &settings, Some(2)).expect("pool");
+        assert_eq!(one.frame(), two.frame());
+        // And some pixels did stop (else this would test nothing adaptive).
+        assert!(one.status().contains("active") && !one.status().starts_with("adaptive: 100%"), "{}", one.status());
     }
 }

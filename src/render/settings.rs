@@ -69,6 +69,10 @@ pub struct RenderSettings {
     pub sampler: SamplerKind,
     pub seed: u64,
     pub sppm: SppmSettings,
+    /// Adaptive sampling: a pixel stops receiving samples once its relative
+    /// standard error falls below this (see `render::pass::ADAPTIVE_*`);
+    /// `None` samples every pixel every pass.
+    pub adaptive_threshold: Option<f64>,
 }
 
 impl Default for RenderSettings {
@@ -83,6 +87,7 @@ impl Default for RenderSettings {
             sampler: SamplerKind::Sobol,
             seed: 0,
             sppm: SppmSettings::default(),
+            adaptive_threshold: None,
         }
     }
 }

@@ -7,6 +7,9 @@ use serde::Deserialize;
 use std::collections::BTreeMap;
 use toml::Spanned;
 
+mod texture;
+pub use texture::{ColorDescription, MappingKind, Numbers, TextureDescription, WrapKind};
+
 pub type Vector = [f64; 3];
 
 #[derive(Debug, Deserialize)]
@@ -71,11 +74,11 @@ pub struct RenderDescription {
 #[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
 pub enum MaterialDescription {
     Diffuse {
-        albedo: Vector,
+        albedo: ColorDescription,
     },
     Mirror {
-        #[serde(default = "white")]
-        tint: Vector,
+        #[serde(default = "white_texture")]
+        tint: ColorDescription,
     },
     Glass {
         #[serde(default = "default_ior")]
@@ -84,7 +87,7 @@ pub enum MaterialDescription {
         tint: Vector,
     },
     Glossy {
-        tint: Vector,
+        tint: ColorDescription,
         roughness: f64,
     },
     Emissive {
@@ -96,6 +99,10 @@ pub enum MaterialDescription {
 
 fn white() -> Vector {
     [1.0; 3]
+}
+
+fn white_texture() -> ColorDescription {
+    ColorDescription::Rgb(white())
 }
 
 fn default_ior() -> f64 {
@@ -150,6 +157,22 @@ pub enum ObjectDescription {
         #[serde(default)]
         transform: TransformDescription,
     },
+    /// A Bezier profile swept about the object's vertical (y) axis: each
+    /// control point is [distance from the axis, height].
+    Revolution {
+        /// One Bezier segment's control points `[[x, y], ...]`, or use `segments`.
+        #[serde(default)]
+        profile: Option<Vec<[f64; 2]>>,
+        /// A chain of segments, each its own control points.
+        #[serde(default)]
+        segments: Option<Vec<Vec<[f64; 2]>>>,
+        /// Close the ends with flat discs.
+        #[serde(default)]
+        caps: bool,
+        material: String,
+        #[serde(default)]
+        transform: TransformDescription,
+    },
 }
 
 impl ObjectDescription {
@@ -159,7 +182,8 @@ impl ObjectDescription {
             | ObjectDescription::Box { material, .. }
             | ObjectDescription::Quad { material, .. }
             | ObjectDescription::Triangle { material, .. }
-            | ObjectDescription::Mesh { material, .. } => material,
+            | ObjectDescription::Mesh { material, .. }
+            | ObjectDescription::Revolution { material, .. } => material,
         }
     }
 }

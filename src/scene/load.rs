@@ -6,12 +6,12 @@ use super::error::{SceneError, line_of};
 use super::{Primitive, Scene};
 use crate::camera::Camera;
 use crate::color::Color;
-use crate::geometry::{AxisBox, Mesh, Quad, Shape, Sphere, Transform};
+use crate::geometry::{AxisBox, Mesh, Quad, Revolution, Shape, Sphere, Transform};
 use crate::material::Material;
 use crate::material::texture::ImageCache;
 use crate::math::Aabb;
 use crate::render::settings::RenderSettings;
-use glam::DVec3;
+use glam::{DAffine3, DVec2, DVec3};
 use std::collections::HashMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -331,6 +331,29 @@ impl Builder<'_> {
                     material,
                 }));
                 meshes.push(mesh);
+            }
+            ObjectDescription::Revolution {
+                profile,
+                segments,
+                caps,
+                transform,
+                ..
+            } => {
+                let segments: Vec<Vec<DVec2>> = match (profile, segments) {
+                    (Some(points), None) => vec![points.iter().map(|p| DVec2::from_array(*p)).collect()],
+                    (None, Some(chain)) => chain.iter().map(|s| s.iter().map(|p| DVec2::from_array(*p)).collect()).collect(),
+                    _ => return Err(self.error(span.clone(), path, "profile", "give exactly one of `profile` or `segments`")),
+                };
+                let field = if profile.is_some() { "profile" } else { "segments" };
+                let flat: Vec<f64> = segments.iter().flatten().flat_map(|p| [p.x, p.y]).collect();
+                self.finite(span, path, field, &flat)?;
+                let transform = self.transform(span, path, transform)?;
+                // The profile lies in the local (x, z) half-plane rotated about z;
+                // scene files are y-up, so local z maps to world y.
+                let y_up = DAffine3::from_cols(DVec3::X, -DVec3::Z, DVec3::Y, DVec3::ZERO);
+                let revolution = Revolution::new(segments, *caps, transform.to_world * y_up)
+                    .map_err(|e| self.error(span.clone(), path, field, e))?;
+                push(Shape::Revolution(Box::new(revolution)));
             }
         }
         Ok(())

@@ -1,0 +1,352 @@
+//! Error against wall time: render progressively and, each time the render
+//! clock passes the next rung of a doubling ladder (1, 2, 4 … s), compare the
+//! current estimate with a converged reference. Only time spent in
+//! `render_pass` is counted: measuring the error does not eat into the budget.
+//!
+//! Metrics, over all pixels and channels, with x the estimate and r the reference:
+//! RMSE = sqrt(mean (x − r)²); relMSE = mean (x − r)² / (r² + ε) with ε = 0.01
+//! (Rousselle, Knaus and Zwicker 2011, so dark pixels do not dominate); and the
+//! mean bias per channel, mean (x − r), which stays near 0 for unbiased
+//! estimators and reveals the consistent-but-biased ones (SPPM) and leaks.
+
+use super::plot::{LinePlot, Series};
+use super::{BenchError, Csv, format_number};
+use crate::camera::Camera;
+use crate::film::{Frame, ToneMap};
+use crate::integrator;
+use crate::output::save_frame;
+use crate::render::render_progressive;
+use crate::render::settings::{IntegratorKind, RenderSettings};
+use crate::sampler::SamplerKind;
+use crate::scene::{LoadedScene, Scene};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+use std::time::{Duration, Instant};
+
+/// The ε of relMSE.
+pub const RELATIVE_MSE_EPSILON: f64 = 0.01;
+
+/// One way of rendering that the curves compare.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Configuration {
+    pub name: String,
+    pub integrator: IntegratorKind,
+    pub sampler: SamplerKind,
+    pub adaptive_threshold: Option<f64>,
+}
+
+impl Configuration {
+    pub fn new(integrator: IntegratorKind, sampler: SamplerKind, adaptive_threshold: Option<f64>) -> Self {
+        let adaptive = adaptive_threshold.map_or(String::new(), |t| format!("+adaptive{t}"));
+        Self {
+            name: format!("{integrator}/{sampler}{adaptive}"),
+            integrator,
+            sampler,
+            adaptive_threshold,
+        }
+    }
+
+    /// The configurations that matter: NEE+MIS with Sobol' (the default), with
+    /// independent samples, and adaptive; BSDF sampling only; SPPM.
+    pub fn standard(adaptive_threshold: f64) -> Vec<Configuration> {
+        vec![
+            Configuration::new(IntegratorKind::PathTracing, SamplerKind::Sobol, None),
+            Configuration::new(IntegratorKind::PathTracing, SamplerKind::Random, None),
+            Configuration::new(IntegratorKind::PathTracing, SamplerKind::Sobol, Some(adaptive_threshold)),
+            Configuration::new(IntegratorKind::BsdfOnly, SamplerKind::Sobol, None),
+            Configuration::new(IntegratorKind::Sppm, SamplerKind::Sobol, None),
+        ]
+    }
+
+    /// `settings` with this configuration's choices applied, at `width`×`height`.
+    pub fn apply(&self, settings: &RenderSettings, width: u32, height: u32) -> RenderSettings {
+        RenderSettings {
+            width,
+            height,
+            samples_per_pixel: None,
+            time_limit: None,
+            integrator: self.integrator,
+            sampler: self.sampler,
+            adaptive_threshold: self.adaptive_threshold,
+            ..settings.clone()
+        }
+    }
+}
+
+/// Error of an estimate against a reference.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ErrorMetrics {
+    pub rmse: f64,
+    pub relative_mse: f64,
+    /// Mean signed error per channel (R, G, B).
+    pub bias: [f64; 3],
+}
+
+/// Compares two frames of the same size.
+pub fn error_metrics(estimate: &Frame, reference: &Frame) -> Result<ErrorMetrics, BenchError> {
+    if (estimate.width, estimate.height) != (reference.width, reference.height) || estimate.pixels.len() != reference.pixels.len() {
+        return Err(BenchError::Reference(format!(
+            "size {}x{} differs from the estimate's {}x{}",
+            reference.width, reference.height, estimate.width, estimate.height
+        )));
+    }
+    let mut squared = 0.0;
+    let mut relative = 0.0;
+    let mut bias = [0.0; 3];
+    for (x, r) in estimate.pixels.iter().zip(&reference.pixels) {
+        for c in 0..3 {
+            let (x, r) = (x[c] as f64, r[c] as f64);
+            let difference = x - r;
+            squared += difference * difference;
+            relative += difference * difference / (r * r + RELATIVE_MSE_EPSILON);
+            bias[c] += difference;
+        }
+    }
+    let pixels = estimate.pixels.len().max(1) as f64;
+    Ok(ErrorMetrics {
+        rmse: (squared / (3.0 * pixels)).sqrt(),
+        relative_mse: relative / (3.0 * pixels),
+        bias: bias.map(|b| b / pixels),
+    })
+}
+
+/// Wall times `first, 2·first, 4·first …` up to and including `last`.
+pub fn time_ladder(first_seconds: f64, last_seconds: f64) -> Vec<f64> {
+    let mut ladder = Vec::new();
+    let mut t = first_seconds.max(1e-3);
+    while t <= last_seconds * (1.0 + 1e-9) {
+        ladder.push(t);
+        t *= 2.0;
+    }
+    ladder
+}
+
+/// The error of one configuration at one rung of the ladder.
+#[derive(Clone, Debug)]
+pub struct CurvePoint {
+    pub target_seconds: f64,
+    /// Render time actually spent: the first pass boundary past the target.
+    pub elapsed_seconds: f64,
+    pub passes: u32,
+    /// The integrator's status then (e.g. the share of pixels adaptive sampling keeps active).
+    pub status: String,
+    pub metrics: ErrorMetrics,
+    pub rejected_samples: u64,
+}
+
+/// What a configuration produced.
+#[derive(Clone, Debug)]
+pub enum CurveOutcome {
+    Measured(Vec<CurvePoint>),
+    /// Not run, and why (e.g. SPPM is not built yet and `create` fell back).
+    Skipped(String),
+}
+
+/// Whether an integrator made for SPPM really is SPPM: until it exists,
+/// `integrator::create` falls back to path tracing, whose status is empty
+/// (or only reports adaptive sampling).
+fn is_fallback(kind: IntegratorKind, status: &str) -> bool {
+    kind == IntegratorKind::Sppm && (status.is_empty() || status.starts_with("adaptive"))
+}
+
+/// Renders with `settings` until the last rung of `ladder` and measures the
+/// error against `reference` at each rung. Runs on the current rayon pool.
+pub fn measure_curve(scene: &Scene, camera: &Camera, settings: &RenderSettings, reference: &Frame, ladder: &[f64]) -> Result<CurveOutcome, BenchError> {
+    let mut integrator = integrator::create(settings);
+    let cancel = AtomicBool::new(false);
+    let mut points = Vec::with_capacity(ladder.len());
+    let mut render_seconds = 0.0;
+    let mut next = 0;
+    while next < ladder.len() {
+        let start = Instant::now();
+        integrator.render_pass(scene, camera, &cancel);
+        render_seconds += start.elapsed().as_secs_f64();
+        if integrator.passes() == 1 && is_fallback(settings.integrator, &integrator.status()) {
+            return Ok(CurveOutcome::Skipped(format!("{} is not available yet (integrator::create fell back to path tracing)", settings.integrator)));
+        }
+        if render_seconds < ladder[next] {
+            continue;
+        }
+        let frame = integrator.frame();
+        let metrics = error_metrics(&frame, reference)?;
+        let status = integrator.status();
+        // One slow pass can cross several rungs; each gets the same estimate.
+        while next < ladder.len() && render_seconds >= ladder[next] {
+            points.push(CurvePoint {
+                target_seconds: ladder[next],
+                elapsed_seconds: render_seconds,
+                passes: integrator.passes(),
+                status: status.clone(),
+                metrics,
+                rejected_samples: integrator.rejected_samples(),
+            });
+            next += 1;
+        }
+    }
+    Ok(CurveOutcome::Measured(points))
+}
+
+/// Where the small reference of a scene file lives: `<directory>/<stem>.exr`.
+pub fn reference_path(directory: &Path, scene_file: &Path) -> PathBuf {
+    let stem = scene_file.file_stem().map_or("scene".into(), |s| s.to_string_lossy().to_string());
+    directory.join(format!("{stem}.exr"))
+}
+
+/// The settings of a reference render: path tracing with NEE+MIS and Sobol'
+/// samples, `width` pixels wide at the scene's aspect, for `seconds`, with a
+/// seed no benchmark run uses (so reference noise is independent of theirs).
+pub fn reference_settings(settings: &RenderSettings, width: u32, seconds: f64) -> RenderSettings {
+    let height = ((width as f64 / settings.aspect()).round() as u32).max(1);
+    RenderSettings {
+        width,
+        height,
+        samples_per_pixel: None,
+        time_limit: Some(Duration::from_secs_f64(seconds)),
+        integrator: IntegratorKind::PathTracing,
+        sampler: SamplerKind::Sobol,
+        seed: REFERENCE_SEED,
+        adaptive_threshold: None,
+        ..settings.clone()
+    }
+}
+
+/// Seed of reference renders; benchmark runs use the scene's seed (0 by default).
+pub const REFERENCE_SEED: u64 = 0x0005_EED0_F2EF;
+
+/// Renders a reference for `loaded` and writes it as EXR at `path`, with how
+/// it was made in the file's metadata; returns the passes rendered.
+pub fn make_reference(loaded: &LoadedScene, settings: &RenderSettings, path: &Path) -> Result<u32, BenchError> {
+    let cancel = AtomicBool::new(false);
+    let integrator = render_progressive(&loaded.scene, &loaded.camera, settings, &cancel, |_, _| {});
+    let metadata = vec![
+        ("Software".to_string(), format!("prism {}", env!("CARGO_PKG_VERSION"))),
+        ("Scene".to_string(), loaded.path.as_ref().map_or("<embedded>".into(), |p| p.display().to_string())),
+        ("Integrator".to_string(), settings.integrator.to_string()),
+        ("Sampler".to_string(), settings.sampler.to_string()),
+        ("Seed".to_string(), settings.seed.to_string()),
+        ("Passes".to_string(), integrator.passes().to_string()),
+    ];
+    save_frame(&integrator.frame(), path, 0.0, ToneMap::Clamp, &metadata).map_err(|e| BenchError::Reference(format!("{}: {e}", path.display())))?;
+    if integrator.rejected_samples() > 0 {
+        return Err(BenchError::Reference(format!("{} samples were NaN or infinite", integrator.rejected_samples())));
+    }
+    Ok(integrator.passes())
+}
+
+/// Results of every configuration on one scene.
+pub struct SceneCurves {
+    pub scene: String,
+    pub width: u32,
+    pub height: u32,
+    pub curves: Vec<(Configuration, CurveOutcome)>,
+}
+
+/// Measures every configuration on one scene at the reference's resolution,
+/// one after another on the current rayon pool; `progress` hears each result.
+pub fn measure_scene(
+    scene_name: &str,
+    loaded: &LoadedScene,
+    reference: &Frame,
+    configurations: &[Configuration],
+    ladder: &[f64],
+    mut progress: impl FnMut(&Configuration, &CurveOutcome),
+) -> Result<SceneCurves, BenchError> {
+    let mut curves = Vec::new();
+    for configuration in configurations {
+        let settings = configuration.apply(&loaded.settings, reference.width, reference.height);
+        let outcome = measure_curve(&loaded.scene, &loaded.camera, &settings, reference, ladder)?;
+        progress(configuration, &outcome);
+        curves.push((configuration.clone(), outcome));
+    }
+    Ok(SceneCurves {
+        scene: scene_name.to_string(),
+        width: reference.width,
+        height: reference.height,
+        curves,
+    })
+}
+
+impl SceneCurves {
+    /// The CSV table: one row per configuration and rung.
+    pub fn csv(&self, machine: &str, threads: usize) -> Csv {
+        let mut csv = Csv::new(vec![
+            "scene",
+            "configuration",
+            "integrator",
+            "sampler",
+            "adaptive_threshold",
+            "target_seconds",
+            "elapsed_seconds",
+            "passes",
+            "rmse",
+            "relmse",
+            "bias_r",
+            "bias_g",
+            "bias_b",
+            "rejected_samples",
+            "status",
+        ]);
+        csv.comments.push(format!("prism bench: error against the reference at doubling render times, {}x{} pixels, {threads} threads", self.width, self.height));
+        csv.comments.push(machine.to_string());
+        for (configuration, outcome) in &self.curves {
+            match outcome {
+                CurveOutcome::Skipped(reason) => csv.comments.push(format!("skipped {}: {reason}", configuration.name)),
+                CurveOutcome::Measured(points) => {
+                    for p in points {
+                        csv.rows.push(vec![
+                            self.scene.clone(),
+                            configuration.name.clone(),
+                            configuration.integrator.to_string(),
+                            configuration.sampler.to_string(),
+                            configuration.adaptive_threshold.map_or(String::new(), |t| t.to_string()),
+                            format!("{}", p.target_seconds),
+                            format!("{:.4}", p.elapsed_seconds),
+                            p.passes.to_string(),
+                            format_number(p.metrics.rmse),
+                            format_number(p.metrics.relative_mse),
+                            format_number(p.metrics.bias[0]),
+                            format_number(p.metrics.bias[1]),
+                            format_number(p.metrics.bias[2]),
+                            p.rejected_samples.to_string(),
+                            p.status.replace(',', ";"),
+                        ]);
+                    }
+                }
+            }
+        }
+        csv
+    }
+
+    /// The log-log plot of RMSE against render time, one line per configuration.
+    pub fn plot(&self) -> LinePlot {
+        let mut series: Vec<Series> = self
+            .curves
+            .iter()
+            .filter_map(|(configuration, outcome)| match outcome {
+                CurveOutcome::Measured(points) => Some(Series {
+                    name: configuration.name.clone(),
+                    points: points.iter().map(|p| (p.elapsed_seconds, p.metrics.rmse)).collect(),
+                    guide: false,
+                }),
+                CurveOutcome::Skipped(_) => None,
+            })
+            .collect();
+        // Guide: the Monte Carlo rate, RMSE ∝ t^(-1/2), through the first curve's start.
+        if let Some(first) = series.first().and_then(|s| s.points.first().copied()) {
+            let end = series.iter().flat_map(|s| s.points.iter().map(|p| p.0)).fold(first.0, f64::max);
+            series.push(Series {
+                name: "∝ t^-1/2".into(),
+                points: vec![first, (end, first.1 * (first.0 / end).sqrt())],
+                guide: true,
+            });
+        }
+        LinePlot {
+            title: format!("{}: RMSE against render time ({}x{})", self.scene, self.width, self.height),
+            x_label: "render time [s]".into(),
+            y_label: "RMSE".into(),
+            log_x: true,
+            log_y: true,
+            series,
+        }
+    }
+}

@@ -1,0 +1,100 @@
+//! The library side of `prism bench`: measurements that say how fast Prism
+//! converges and how it scales, each written as CSV (with the machine load in
+//! its header, since the numbers mean little without it) and drawn as PNG.
+//!
+//! - [`error_curves`]: error against a reference image at doubling wall times,
+//!   one curve per integrator / sampler / adaptive configuration;
+//! - [`scaling`]: BVH build time and ray cost against triangle count, render
+//!   time against resolution and thread count;
+//! - [`stress`]: extreme scenes, counting NaN samples, self-intersections and
+//!   leaks through closed surfaces;
+//! - [`plot`]: the line plots.
+
+pub mod error_curves;
+pub mod plot;
+pub mod scaling;
+pub mod stress;
+
+use std::io::Write;
+use std::path::Path;
+
+/// Why a benchmark could not run or write its results.
+#[derive(Debug, thiserror::Error)]
+pub enum BenchError {
+    #[error("{path}: {source}")]
+    Io { path: String, source: std::io::Error },
+    #[error(transparent)]
+    Scene(#[from] crate::scene::SceneError),
+    #[error("reference image: {0}")]
+    Reference(String),
+    #[error("plot {path}: {message}")]
+    Plot { path: String, message: String },
+    #[error("cannot start worker threads: {0}")]
+    Threads(#[from] rayon::ThreadPoolBuildError),
+}
+
+/// One line describing the machine and its load, for CSV headers: the
+/// benchmarks share a machine, and a time means little without its load.
+pub fn machine_note() -> String {
+    let load = std::fs::read_to_string("/proc/loadavg").map_or_else(|_| "unknown".to_string(), |s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "));
+    let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
+    format!("{cores} logical cores, load average (1/5/15 min) {load}")
+}
+
+/// A CSV table: `#` comment lines, a header, rows; written atomically.
+pub struct Csv {
+    pub comments: Vec<String>,
+    pub header: Vec<&'static str>,
+    pub rows: Vec<Vec<String>>,
+}
+
+impl Csv {
+    pub fn new(header: Vec<&'static str>) -> Self {
+        Self {
+            comments: Vec::new(),
+            header,
+            rows: Vec::new(),
+        }
+    }
+
+    pub fn to_text(&self) -> String {
+        let mut text = String::new();
+        for comment in &self.comments {
+            text.push_str("# ");
+            text.push_str(comment);
+            text.push('\n');
+        }
+        text.push_str(&self.header.join(","));
+        text.push('\n');
+        for row in &self.rows {
+            text.push_str(&row.join(","));
+            text.push('\n');
+        }
+        text
+    }
+
+    pub fn write(&self, path: &Path) -> Result<(), BenchError> {
+        write_atomically(path, self.to_text().as_bytes())
+    }
+}
+
+/// Writes through a temporary file and a rename, so a reader never sees half a file.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), BenchError> {
+    let io = |source| BenchError::Io {
+        path: path.display().to_string(),
+        source,
+    };
+    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent).map_err(io)?;
+    }
+    let temporary = path.with_extension("partial");
+    let mut file = std::fs::File::create(&temporary).map_err(io)?;
+    file.write_all(bytes).map_err(io)?;
+    file.sync_all().map_err(io)?;
+    std::fs::rename(&temporary, path).map_err(io)
+}
+
+/// A float for CSV: enough digits to plot, no thousands of them.
+pub fn format_number(x: f64) -> String {
+    format!("{x:.6e}")
+}

@@ -1,0 +1,342 @@
+//! How cost grows with the problem: BVH build time and ray cost against
+//! triangle count (generated spheres of 1k … 1M triangles), and render time
+//! against resolution and thread count.
+//!
+//! Expectations: a binned SAH build sorts nothing but partitions each level
+//! once, O(n) per level over O(log n) levels, so time / (n log₂ n) should stay
+//! flat; a ray visits O(log n) nodes of a balanced tree, so ns per ray should
+//! grow linearly in log₂ n (Wald 2007; pbrt-v4 §7.3).
+
+use super::plot::{LinePlot, Series};
+use super::{BenchError, Csv, format_number};
+use crate::accel::Bvh;
+use crate::camera::Camera;
+use crate::color::Color;
+use crate::geometry::{Mesh, Shape};
+use crate::integrator;
+use crate::material::{Material, Texture};
+use crate::math::{Aabb, Ray};
+use crate::render::settings::RenderSettings;
+use crate::sampler::{Sampler, SamplerKind};
+use crate::scene::{Primitive, Scene};
+use glam::DVec3;
+use std::f64::consts::PI;
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+/// A closed, consistently outward-wound UV sphere with about `target_triangles`
+/// faces, vertices shared between faces (so its edges are watertight).
+pub fn sphere_mesh(target_triangles: u32, center: DVec3, radius: f64) -> Mesh {
+    // `segments` around, `rings` = segments / 2 from pole to pole: two fans of
+    // `segments` triangles plus 2·segments per inner band ≈ segments² faces.
+    let segments = ((target_triangles as f64).sqrt().round() as u32 + 2).max(4);
+    let rings = (segments / 2).max(2);
+    let mut mesh = Mesh::default();
+    let point = |theta: f64, phi: f64| center + radius * DVec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+    mesh.positions.push(center + DVec3::new(0.0, radius, 0.0));
+    for ring in 1..rings {
+        let theta = PI * ring as f64 / rings as f64;
+        for segment in 0..segments {
+            mesh.positions.push(point(theta, 2.0 * PI * segment as f64 / segments as f64));
+        }
+    }
+    let south = mesh.positions.len() as u32;
+    mesh.positions.push(center - DVec3::new(0.0, radius, 0.0));
+    let vertex = |ring: u32, segment: u32| 1 + (ring - 1) * segments + segment % segments;
+    for s in 0..segments {
+        mesh.faces.push([0, vertex(1, s), vertex(1, s + 1)]);
+        mesh.faces.push([south, vertex(rings - 1, s + 1), vertex(rings - 1, s)]);
+        for ring in 1..rings - 1 {
+            let (a, b, c, d) = (vertex(ring, s), vertex(ring, s + 1), vertex(ring + 1, s), vertex(ring + 1, s + 1));
+            mesh.faces.push([a, c, b]);
+            mesh.faces.push([b, c, d]);
+        }
+    }
+    orient_outward(&mut mesh, center);
+    mesh
+}
+
+/// Flips faces whose normal points towards `inside` (a point the closed,
+/// star-shaped mesh surrounds), so every face is wound outward.
+pub fn orient_outward(mesh: &mut Mesh, inside: DVec3) {
+    for face in &mut mesh.faces {
+        let [a, b, c] = face.map(|i| mesh.positions[i as usize]);
+        if (b - a).cross(c - a).dot((a + b + c) / 3.0 - inside) < 0.0 {
+            face.swap(1, 2);
+        }
+    }
+}
+
+/// A scene of one mesh with a grey diffuse material and no lights.
+pub fn mesh_scene(mesh: Mesh) -> Scene {
+    let primitives: Vec<Primitive> = mesh.triangles(0).map(|t| Primitive { shape: Shape::Triangle(t), material: 0 }).collect();
+    let materials = vec![Material::Diffuse {
+        albedo: Texture::Constant(Color::splat(0.5)),
+    }];
+    Scene::new(primitives, vec![mesh], materials, Color::ZERO)
+}
+
+/// One row of the BVH measurement.
+#[derive(Clone, Debug)]
+pub struct BvhRow {
+    pub triangles: usize,
+    pub nodes: usize,
+    /// Fastest of several builds (the least disturbed by other load).
+    pub build_seconds: f64,
+    pub rays: u64,
+    pub ns_per_ray: f64,
+    pub hit_fraction: f64,
+}
+
+/// Builds BVHs over spheres of each triangle count and traces `rays` camera-like
+/// rays (about 70% hitting) through each, on the current thread.
+pub fn measure_bvh(triangle_counts: &[u32], rays: u64, mut progress: impl FnMut(&BvhRow)) -> Vec<BvhRow> {
+    let mut rows = Vec::new();
+    for &target in triangle_counts {
+        let scene = mesh_scene(sphere_mesh(target, DVec3::ZERO, 1.0));
+        let bounds: Vec<Aabb> = scene.primitives.iter().map(|p| p.shape.bounds()).collect();
+        // Repeat small builds so each measurement spans at least ~0.3 s.
+        let repetitions = (300_000 / bounds.len().max(1)).clamp(1, 50);
+        let mut build_seconds = f64::INFINITY;
+        let mut nodes = 0;
+        for _ in 0..repetitions {
+            let start = Instant::now();
+            let (bvh, _) = Bvh::build(&bounds);
+            build_seconds = build_seconds.min(start.elapsed().as_secs_f64());
+            nodes = bvh.node_count();
+        }
+        let (seconds, hits) = trace_rays(&scene, rays);
+        let row = BvhRow {
+            triangles: bounds.len(),
+            nodes,
+            build_seconds,
+            rays,
+            ns_per_ray: seconds * 1e9 / rays.max(1) as f64,
+            hit_fraction: hits as f64 / rays.max(1) as f64,
+        };
+        progress(&row);
+        rows.push(row);
+    }
+    rows
+}
+
+/// Traces rays from a point 3 radii away towards a disk 1.2 radii wide
+/// around the unit sphere's centre; returns (seconds, hits).
+fn trace_rays(scene: &Scene, rays: u64) -> (f64, u64) {
+    let origin = DVec3::new(0.0, 0.0, 3.0);
+    let directions: Vec<DVec3> = (0..rays)
+        .map(|i| {
+            let u = Sampler::new(SamplerKind::Random, i, 0, 7).next_2d();
+            let disk = crate::math::warp::square_to_concentric_disk(u) * 1.2;
+            DVec3::new(disk.x, disk.y, 0.0) - origin
+        })
+        .collect();
+    let start = Instant::now();
+    let hits = directions.iter().filter(|&&d| scene.intersect(&Ray::new(origin, d), f64::INFINITY).is_some()).count();
+    (start.elapsed().as_secs_f64(), hits as u64)
+}
+
+/// One row of the render-time measurement.
+#[derive(Clone, Debug)]
+pub struct RenderRow {
+    pub width: u32,
+    pub height: u32,
+    pub threads: usize,
+    pub passes: u32,
+    pub seconds: f64,
+    pub ns_per_sample: f64,
+}
+
+/// Renders `passes` passes at each width (height by the settings' aspect)
+/// with each thread count.
+pub fn measure_render(scene: &Scene, camera: &Camera, settings: &RenderSettings, widths: &[u32], threads: &[usize], passes: u32, mut progress: impl FnMut(&RenderRow)) -> Result<Vec<RenderRow>, BenchError> {
+    let mut rows = Vec::new();
+    for &thread_count in threads {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(thread_count).build()?;
+        for &width in widths {
+            let height = ((width as f64 / settings.aspect()).round() as u32).max(1);
+            let settings = RenderSettings {
+                width,
+                height,
+                samples_per_pixel: Some(passes),
+                time_limit: None,
+                ..settings.clone()
+            };
+            let mut integrator = integrator::create(&settings);
+            let cancel = AtomicBool::new(false);
+            let start = Instant::now();
+            pool.install(|| {
+                for _ in 0..passes {
+                    integrator.render_pass(scene, camera, &cancel);
+                }
+            });
+            let seconds = start.elapsed().as_secs_f64();
+            let row = RenderRow {
+                width,
+                height,
+                threads: thread_count,
+                passes,
+                seconds,
+                ns_per_sample: seconds * 1e9 / (passes as f64 * settings.pixel_count() as f64),
+            };
+            progress(&row);
+            rows.push(row);
+        }
+    }
+    Ok(rows)
+}
+
+/// Least-squares fit of y = a + b·x.
+fn fit_line(points: &[(f64, f64)]) -> (f64, f64) {
+    let n = points.len() as f64;
+    let (sx, sy) = points.iter().fold((0.0, 0.0), |(sx, sy), &(x, y)| (sx + x, sy + y));
+    let (mx, my) = (sx / n, sy / n);
+    let (sxy, sxx) = points.iter().fold((0.0, 0.0), |(a, b), &(x, y)| (a + (x - mx) * (y - my), b + (x - mx) * (x - mx)));
+    let slope = if sxx > 0.0 { sxy / sxx } else { 0.0 };
+    (my - slope * mx, slope)
+}
+
+/// Writes `bvh_scaling.csv` and `bvh_build.png`, `ray_cost.png` into `directory`.
+pub fn write_bvh_results(rows: &[BvhRow], machine: &str, directory: &Path) -> Result<(), BenchError> {
+    let mut csv = Csv::new(vec!["triangles", "nodes", "build_seconds", "build_ns_per_n_log2_n", "rays", "ns_per_ray", "hit_fraction"]);
+    csv.comments.push("prism bench --scaling: BVH build (fastest of repeated builds) and single-thread nearest-hit ray cost on UV spheres".into());
+    csv.comments.push(machine.to_string());
+    for r in rows {
+        let n = r.triangles as f64;
+        csv.rows.push(vec![
+            r.triangles.to_string(),
+            r.nodes.to_string(),
+            format_number(r.build_seconds),
+            format_number(r.build_seconds * 1e9 / (n * n.log2().max(1.0))),
+            r.rays.to_string(),
+            format_number(r.ns_per_ray),
+            format!("{:.4}", r.hit_fraction),
+        ]);
+    }
+    csv.write(&directory.join("bvh_scaling.csv"))?;
+
+    // Guide: c · n log₂ n through the largest measurement.
+    let guide = rows.last().map(|last| {
+        let n = last.triangles as f64;
+        let c = last.build_seconds / (n * n.log2());
+        Series {
+            name: "c·n·log2(n)".into(),
+            points: rows.iter().map(|r| (r.triangles as f64, c * r.triangles as f64 * (r.triangles as f64).log2())).collect(),
+            guide: true,
+        }
+    });
+    let mut build = LinePlot {
+        title: "BVH build time against triangle count".into(),
+        x_label: "triangles".into(),
+        y_label: "build time [s]".into(),
+        log_x: true,
+        log_y: true,
+        series: vec![Series {
+            name: "binned SAH build".into(),
+            points: rows.iter().map(|r| (r.triangles as f64, r.build_seconds)).collect(),
+            guide: false,
+        }],
+    };
+    build.series.extend(guide);
+    build.write_png(&directory.join("bvh_build.png"))?;
+
+    let log_points: Vec<(f64, f64)> = rows.iter().map(|r| ((r.triangles as f64).log2(), r.ns_per_ray)).collect();
+    let (a, b) = fit_line(&log_points);
+    let rays = LinePlot {
+        title: "Cost per ray against triangle count".into(),
+        x_label: "triangles".into(),
+        y_label: "ns per ray (1 thread)".into(),
+        log_x: true,
+        log_y: false,
+        series: vec![
+            Series {
+                name: "nearest hit".into(),
+                points: rows.iter().map(|r| (r.triangles as f64, r.ns_per_ray)).collect(),
+                guide: false,
+            },
+            Series {
+                name: format!("fit {a:.0} + {b:.1}·log2(n) ns"),
+                points: rows.iter().map(|r| (r.triangles as f64, a + b * (r.triangles as f64).log2())).collect(),
+                guide: true,
+            },
+        ],
+    };
+    rays.write_png(&directory.join("ray_cost.png"))
+}
+
+/// Writes `render_scaling.csv` and `render_scaling.png` into `directory`.
+pub fn write_render_results(rows: &[RenderRow], scene_name: &str, machine: &str, directory: &Path) -> Result<(), BenchError> {
+    let mut csv = Csv::new(vec!["scene", "width", "height", "threads", "passes", "seconds", "ns_per_sample"]);
+    csv.comments.push("prism bench --scaling: render time of a fixed number of passes against resolution and thread count".into());
+    csv.comments.push(machine.to_string());
+    for r in rows {
+        csv.rows.push(vec![
+            scene_name.to_string(),
+            r.width.to_string(),
+            r.height.to_string(),
+            r.threads.to_string(),
+            r.passes.to_string(),
+            format_number(r.seconds),
+            format_number(r.ns_per_sample),
+        ]);
+    }
+    csv.write(&directory.join("render_scaling.csv"))?;
+    let mut threads: Vec<usize> = rows.iter().map(|r| r.threads).collect();
+    threads.dedup();
+    let plot = LinePlot {
+        title: format!("Render time against resolution ({scene_name})"),
+        x_label: "pixels".into(),
+        y_label: "seconds per pass".into(),
+        log_x: true,
+        log_y: true,
+        series: threads
+            .iter()
+            .map(|&t| Series {
+                name: format!("{t} thread{}", if t == 1 { "" } else { "s" }),
+                points: rows.iter().filter(|r| r.threads == t).map(|r| ((r.width * r.height) as f64, r.seconds / r.passes.max(1) as f64)).collect(),
+                guide: false,
+            })
+            .collect(),
+    };
+    plot.write_png(&directory.join("render_scaling.png"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sphere_mesh_is_closed_and_outward() {
+        let mesh = sphere_mesh(400, DVec3::new(1.0, 2.0, 3.0), 2.0);
+        // Closed: every edge is shared by exactly two faces, in opposite directions.
+        let mut edges = std::collections::HashMap::new();
+        for f in &mesh.faces {
+            for k in 0..3 {
+                *edges.entry((f[k], f[(k + 1) % 3])).or_insert(0) += 1;
+            }
+        }
+        for (&(a, b), &count) in &edges {
+            assert_eq!(count, 1, "edge {a}-{b} used twice in one direction");
+            assert_eq!(edges.get(&(b, a)), Some(&1), "edge {a}-{b} has no opposite");
+        }
+        // Signed volume (divergence theorem) positive and near 4/3 π r³
+        // within 5%: a 400-face sphere underestimates the volume by ~2%.
+        let volume: f64 = mesh
+            .faces
+            .iter()
+            .map(|f| {
+                let [a, b, c] = f.map(|i| mesh.positions[i as usize] - DVec3::new(1.0, 2.0, 3.0));
+                a.dot(b.cross(c)) / 6.0
+            })
+            .sum();
+        let exact = 4.0 / 3.0 * PI * 8.0;
+        assert!((volume / exact - 1.0).abs() < 0.05, "volume {volume} vs {exact}");
+    }
+
+    #[test]
+    fn line_fit_recovers_a_line() {
+        let (a, b) = fit_line(&[(1.0, 5.0), (2.0, 7.0), (3.0, 9.0)]);
+        assert!((a - 3.0).abs() < 1e-12 && (b - 2.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,500 @@
+//! Numerical stress: scenes at the edges of floating-point range, rendered
+//! and probed, counting what must never happen.
+//!
+//! - NaN or infinite samples: the film drops and counts them
+//!   (`Integrator::rejected_samples`); must be 0.
+//! - Self-intersections: a ray spawned from a hit point (either side, as
+//!   reflection and refraction do) that hits the same primitive again within
+//!   10⁻⁶ of that primitive's size. A correct offset (pbrt-v4 §6.8.6) leaves
+//!   only legitimate re-hits, which lie at distances of the order of the
+//!   primitive's size (the far side of a sphere); the chance that a
+//!   cosine-distributed ray re-hits legitimately that close is ~10⁻⁶.
+//! - Leaks: rays aimed exactly at the vertices and edge midpoints of a closed
+//!   mesh (where a non-watertight triangle test misses both neighbours), from
+//!   inside and from outside, that hit nothing.
+//!
+//! The scenes: the Cornell box scaled to 10⁻⁴ and to 10⁵ units and moved 10⁵
+//! from the origin; smallpt's room of radius-10⁵ spheres; light grazing a
+//! floor; glass nested in glass with nearly coincident surfaces.
+
+use super::scaling::{mesh_scene, sphere_mesh};
+use super::{BenchError, Csv};
+use crate::geometry::{Mesh, SurfaceHit, Transform};
+use crate::integrator;
+use crate::math::{Frame as LocalFrame, Ray, warp};
+use crate::render::settings::{IntegratorKind, RenderSettings};
+use crate::sampler::{Sampler, SamplerKind};
+use crate::scene::{LoadedScene, Scene, load_scene_str};
+use glam::DVec3;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+/// A re-hit of the same primitive nearer than this fraction of its size is a self-intersection.
+pub const SELF_HIT_FRACTION: f64 = 1e-6;
+
+/// How hard to push.
+#[derive(Clone, Debug)]
+pub struct StressOptions {
+    pub width: u32,
+    pub height: u32,
+    pub passes: u32,
+    /// Probe rays per scene (self-intersections) and per mesh (leaks).
+    pub rays: u64,
+    /// A closed OBJ mesh to test for leaks as well (the shipped bunny).
+    pub closed_mesh: Option<PathBuf>,
+    /// SPPM photons per pass (once SPPM exists), kept small for fast runs.
+    pub photons_per_iteration: u32,
+}
+
+/// One count: in `scene`, `failures` of `tested` did what must not happen.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StressRow {
+    pub scene: String,
+    pub check: String,
+    pub tested: u64,
+    pub failures: u64,
+}
+
+/// The Cornell box (the shipped scene's walls, light, mirror and glass balls)
+/// with every coordinate mapped to `offset + scale · x / 555`.
+pub fn cornell_toml(scale: f64, offset: f64) -> String {
+    let p = |v: [f64; 3]| format!("[{:e}, {:e}, {:e}]", offset + scale * v[0] / 555.0, offset + scale * v[1] / 555.0, offset + scale * v[2] / 555.0);
+    let e = |v: [f64; 3]| format!("[{:e}, {:e}, {:e}]", scale * v[0] / 555.0, scale * v[1] / 555.0, scale * v[2] / 555.0);
+    let quad = |corner, u, v, material: &str| format!("[[objects]]\ntype = \"quad\"\ncorner = {}\nedge_u = {}\nedge_v = {}\nmaterial = \"{material}\"\n", p(corner), e(u), e(v));
+    let sphere = |center, radius: f64, material: &str| format!("[[objects]]\ntype = \"sphere\"\ncenter = {}\nradius = {:e}\nmaterial = \"{material}\"\n", p(center), scale * radius / 555.0);
+    let mut text = format!(
+        "[camera]\nposition = {}\nlook_at = {}\nfov_y_degrees = 39.3\n\n{MATERIALS}",
+        p([278.0, 273.0, -800.0]),
+        p([278.0, 273.0, 0.0])
+    );
+    for object in [
+        quad([0.0, 0.0, 0.0], [555.0, 0.0, 0.0], [0.0, 0.0, 555.0], "white"),
+        quad([0.0, 555.0, 0.0], [555.0, 0.0, 0.0], [0.0, 0.0, 555.0], "white"),
+        quad([0.0, 0.0, 555.0], [555.0, 0.0, 0.0], [0.0, 555.0, 0.0], "white"),
+        quad([555.0, 0.0, 0.0], [0.0, 555.0, 0.0], [0.0, 0.0, 555.0], "red"),
+        quad([0.0, 0.0, 0.0], [0.0, 555.0, 0.0], [0.0, 0.0, 555.0], "green"),
+        quad([213.0, 548.7, 227.0], [130.0, 0.0, 0.0], [0.0, 0.0, 105.0], "light"),
+        sphere([380.0, 100.0, 380.0], 100.0, "mirror"),
+        sphere([180.0, 100.0, 200.0], 100.0, "glass"),
+    ] {
+        text.push('\n');
+        text.push_str(&object);
+    }
+    text
+}
+
+const MATERIALS: &str = r#"[materials.white]
+type = "diffuse"
+albedo = [0.73, 0.73, 0.73]
+[materials.red]
+type = "diffuse"
+albedo = [0.65, 0.05, 0.05]
+[materials.green]
+type = "diffuse"
+albedo = [0.12, 0.45, 0.15]
+[materials.light]
+type = "emissive"
+radiance = [17, 12, 4]
+[materials.mirror]
+type = "mirror"
+[materials.glass]
+type = "glass"
+ior = 1.5
+"#;
+
+/// smallpt's room (Beason 2008): walls are spheres of radius 10⁵ whose
+/// surfaces pass within 100 units of the camera; the light a sphere of
+/// radius 600 poking through the ceiling.
+const SMALLPT: &str = r#"
+[camera]
+position = [50, 52, 295.6]
+look_at = [50, 51.957388, 294.6]
+fov_y_degrees = 54.35
+[materials.red]
+type = "diffuse"
+albedo = [0.75, 0.25, 0.25]
+[materials.blue]
+type = "diffuse"
+albedo = [0.25, 0.25, 0.75]
+[materials.white]
+type = "diffuse"
+albedo = [0.75, 0.75, 0.75]
+[materials.black]
+type = "diffuse"
+albedo = [0, 0, 0]
+[materials.mirror]
+type = "mirror"
+tint = [0.999, 0.999, 0.999]
+[materials.glass]
+type = "glass"
+ior = 1.5
+[materials.light]
+type = "emissive"
+radiance = [12, 12, 12]
+[[objects]]
+type = "sphere"
+center = [100001, 40.8, 81.6]
+radius = 1e5
+material = "red"
+[[objects]]
+type = "sphere"
+center = [-99901, 40.8, 81.6]
+radius = 1e5
+material = "blue"
+[[objects]]
+type = "sphere"
+center = [50, 40.8, 1e5]
+radius = 1e5
+material = "white"
+[[objects]]
+type = "sphere"
+center = [50, 40.8, -99830]
+radius = 1e5
+material = "black"
+[[objects]]
+type = "sphere"
+center = [50, 1e5, 81.6]
+radius = 1e5
+material = "white"
+[[objects]]
+type = "sphere"
+center = [50, -99918.4, 81.6]
+radius = 1e5
+material = "white"
+[[objects]]
+type = "sphere"
+center = [27, 16.5, 47]
+radius = 16.5
+material = "mirror"
+[[objects]]
+type = "sphere"
+center = [73, 16.5, 78]
+radius = 16.5
+material = "glass"
+[[objects]]
+type = "sphere"
+center = [50, 681.33, 81.6]
+radius = 600
+material = "light"
+"#;
+
+/// A floor lit only by a light standing on its far edge, 1 mm above it,
+/// seen from just above the floor: every light path grazes.
+const GRAZING: &str = r#"
+[camera]
+position = [0, 0.02, -4]
+look_at = [0, 0, 0]
+fov_y_degrees = 30
+[materials.floor]
+type = "diffuse"
+albedo = [0.8, 0.8, 0.8]
+[materials.shiny]
+type = "glossy"
+tint = [0.9, 0.9, 0.9]
+roughness = 0.05
+[materials.light]
+type = "emissive"
+radiance = [50, 50, 50]
+[[objects]]
+type = "quad"
+corner = [-5, 0, -5]
+edge_u = [0, 0, 10]
+edge_v = [10, 0, 0]
+material = "floor"
+[[objects]]
+type = "quad"
+corner = [-3, 0.001, 5]
+edge_u = [0, 0.05, 0]
+edge_v = [6, 0, 0]
+material = "light"
+[[objects]]
+type = "sphere"
+center = [0.5, 0.3, 0]
+radius = 0.3
+material = "shiny"
+"#;
+
+/// Glass in glass in glass: a glass box holding a water sphere holding a
+/// diamond sphere whose surface lies 10⁻⁹ inside the water's, and a small
+/// glass ball inside that.
+const NESTED_GLASS: &str = r#"
+[camera]
+position = [0, 1.5, -5]
+look_at = [0, 1, 0]
+fov_y_degrees = 40
+[materials.floor]
+type = "diffuse"
+albedo = [0.7, 0.7, 0.7]
+[materials.glass]
+type = "glass"
+ior = 1.5
+[materials.water]
+type = "glass"
+ior = 1.33
+[materials.diamond]
+type = "glass"
+ior = 2.4
+[materials.light]
+type = "emissive"
+radiance = [10, 10, 10]
+[[objects]]
+type = "quad"
+corner = [-10, 0, -10]
+edge_u = [0, 0, 20]
+edge_v = [20, 0, 0]
+material = "floor"
+[[objects]]
+type = "quad"
+corner = [-1, 4, -1]
+edge_u = [2, 0, 0]
+edge_v = [0, 0, 2]
+material = "light"
+[[objects]]
+type = "box"
+min = [-1, 0, -1]
+max = [1, 2, 1]
+material = "glass"
+[[objects]]
+type = "sphere"
+center = [0, 1, 0]
+radius = 0.8
+material = "water"
+[[objects]]
+type = "sphere"
+center = [0, 1, 0]
+radius = 0.799999999
+material = "diamond"
+[[objects]]
+type = "sphere"
+center = [0, 1, 0]
+radius = 0.3
+material = "glass"
+"#;
+
+/// The extreme scenes, by name, as scene-file text.
+pub fn stress_scenes() -> Vec<(&'static str, String)> {
+    vec![
+        ("cornell-tiny-1e-4", cornell_toml(1e-4, 0.0)),
+        ("cornell-huge-1e5", cornell_toml(1e5, 0.0)),
+        ("cornell-far-1e5-from-origin", cornell_toml(1.0, 1e5)),
+        ("smallpt-1e5-radius-walls", SMALLPT.to_string()),
+        ("grazing-light", GRAZING.to_string()),
+        ("nested-glass", NESTED_GLASS.to_string()),
+    ]
+}
+
+/// Renders `passes` passes and returns (samples, rejected NaN/inf samples),
+/// or `None` when `kind` is not available (SPPM before it lands).
+pub fn rejected_samples(loaded: &LoadedScene, kind: IntegratorKind, options: &StressOptions) -> Option<(u64, u64)> {
+    let settings = RenderSettings {
+        width: options.width,
+        height: options.height,
+        integrator: kind,
+        samples_per_pixel: Some(options.passes),
+        sppm: crate::render::settings::SppmSettings {
+            photons_per_iteration: options.photons_per_iteration,
+            ..loaded.settings.sppm
+        },
+        ..loaded.settings.clone()
+    };
+    let mut integrator = integrator::create(&settings);
+    let cancel = AtomicBool::new(false);
+    for pass in 0..options.passes {
+        integrator.render_pass(&loaded.scene, &loaded.camera, &cancel);
+        if pass == 0 && kind == IntegratorKind::Sppm && integrator.status().is_empty() {
+            return None;
+        }
+    }
+    Some((options.passes as u64 * settings.pixel_count() as u64, integrator.rejected_samples()))
+}
+
+/// Random walks from `origin` (uniform first direction, then cosine-weighted
+/// about either side of each hit's geometric normal, four bounces), each
+/// continuation made by `Ray::spawn`: returns (spawned rays, self-intersections).
+pub fn self_intersections(scene: &Scene, origin: DVec3, rays: u64) -> (u64, u64) {
+    self_intersections_with(scene, origin, rays, |hit, direction| Ray::spawn(hit.point, hit.point_error, hit.geometric_normal, direction))
+}
+
+/// [`self_intersections`] with continuation rays made by `spawn(hit, direction)`
+/// (tests use a naive spawn to show the count can fail).
+pub fn self_intersections_with(scene: &Scene, origin: DVec3, rays: u64, spawn: impl Fn(&SurfaceHit, DVec3) -> Ray) -> (u64, u64) {
+    let (mut spawned, mut self_hits) = (0, 0);
+    for i in 0..rays {
+        let mut sampler = Sampler::new(SamplerKind::Random, i, 0, 11);
+        let mut ray = Ray::new(origin, warp::square_to_uniform_sphere(sampler.next_2d()));
+        let Some(mut hit) = scene.intersect(&ray, f64::INFINITY) else {
+            continue;
+        };
+        for _bounce in 0..4 {
+            let side = if sampler.next_1d() < 0.5 { 1.0 } else { -1.0 };
+            let normal = side * hit.hit.geometric_normal;
+            let direction = LocalFrame::from_normal(normal).to_world(warp::square_to_cosine_hemisphere(sampler.next_2d()));
+            ray = spawn(&hit.hit, direction);
+            spawned += 1;
+            let Some(next) = scene.intersect(&ray, f64::INFINITY) else {
+                break;
+            };
+            let size = scene.primitives[hit.primitive as usize].shape.bounds().extent().length();
+            if next.primitive == hit.primitive && next.hit.t < SELF_HIT_FRACTION * size {
+                self_hits += 1;
+            }
+            hit = next;
+        }
+    }
+    (spawned, self_hits)
+}
+
+/// Probe rays aimed exactly at a closed mesh's vertices and edge midpoints,
+/// where a triangle test that is not watertight lets rays slip between
+/// neighbours: from outside along the surface normal there (only where every
+/// adjacent face faces that ray, so the ray must enter the surface: near the
+/// silhouette a ray may legitimately graze past a vertex), and, when a point
+/// `inside` is given, from there at the targets and in uniform directions
+/// (everything leaving an interior point must hit). Returns (rays, leaks).
+pub fn leaks(mesh: &Mesh, inside: Option<DVec3>, rays: u64) -> (u64, u64) {
+    let targets = entry_targets(mesh);
+    if targets.is_empty() {
+        return (0, 0);
+    }
+    let extent = crate::math::Aabb::from_points(&mesh.positions).extent().length();
+    let scene = mesh_scene(mesh.clone());
+    let (mut tested, mut leaked) = (0, 0);
+    for i in 0..rays {
+        let mut sampler = Sampler::new(SamplerKind::Random, i, 0, 13);
+        let (target, normal) = targets[(sampler.next_1d() * targets.len() as f64) as usize % targets.len()];
+        let (origin, direction) = match inside {
+            Some(point) if i % 3 == 1 => (point, target - point),
+            Some(point) if i % 3 == 2 => (point, warp::square_to_uniform_sphere(sampler.next_2d())),
+            _ => (target + extent * normal, -normal),
+        };
+        if direction.length_squared() == 0.0 {
+            continue;
+        }
+        tested += 1;
+        if scene.intersect(&Ray::new(origin, direction), f64::INFINITY).is_none() {
+            leaked += 1;
+        }
+    }
+    (tested, leaked)
+}
+
+/// Vertices and edge midpoints with the unit normal a ray must come along to
+/// enter there: the sum of the adjacent faces' normals, kept only where each
+/// adjacent face has a normal within ~84° of it (the fan seen along it is not folded).
+fn entry_targets(mesh: &Mesh) -> Vec<(DVec3, DVec3)> {
+    let face_normal = |f: &[u32; 3]| {
+        let [a, b, c] = f.map(|i| mesh.positions[i as usize]);
+        (b - a).cross(c - a).normalize_or_zero()
+    };
+    let mut vertex_faces: Vec<Vec<DVec3>> = vec![Vec::new(); mesh.positions.len()];
+    let mut edge_faces: std::collections::HashMap<(u32, u32), Vec<DVec3>> = std::collections::HashMap::new();
+    for face in &mesh.faces {
+        let n = face_normal(face);
+        for k in 0..3 {
+            let (a, b) = (face[k], face[(k + 1) % 3]);
+            vertex_faces[a as usize].push(n);
+            edge_faces.entry((a.min(b), a.max(b))).or_default().push(n);
+        }
+    }
+    let unfolded = |normals: &[DVec3]| {
+        let sum: DVec3 = normals.iter().sum();
+        let n = sum.normalize_or_zero();
+        (n != DVec3::ZERO && normals.iter().all(|m| m.dot(n) > 0.1)).then_some(n)
+    };
+    let mut targets = Vec::new();
+    for (v, normals) in vertex_faces.iter().enumerate() {
+        if let Some(n) = unfolded(normals) {
+            targets.push((mesh.positions[v], n));
+        }
+    }
+    for (&(a, b), normals) in &edge_faces {
+        if let Some(n) = unfolded(normals) {
+            targets.push(((mesh.positions[a as usize] + mesh.positions[b as usize]) * 0.5, n));
+        }
+    }
+    // HashMap order is random: sort so runs are reproducible.
+    targets.sort_by(|x, y| x.0.to_array().partial_cmp(&y.0.to_array()).unwrap_or(std::cmp::Ordering::Equal));
+    targets
+}
+
+/// The closed meshes the leak test uses: spheres at the same extremes as the
+/// scenes, and `closed_mesh` (an OBJ) when given. Each with a point inside, if known.
+fn closed_meshes(options: &StressOptions) -> Result<Vec<(String, Mesh, Option<DVec3>)>, BenchError> {
+    let mut meshes = Vec::new();
+    for (name, center, radius) in [
+        ("sphere-mesh-radius-1e-4", DVec3::ZERO, 1e-4),
+        ("sphere-mesh-radius-1e5", DVec3::ZERO, 1e5),
+        ("sphere-mesh-1e5-from-origin", DVec3::splat(1e5), 1.0),
+        ("tiny-sphere-mesh-1e5-from-origin", DVec3::splat(1e5), 1e-4),
+    ] {
+        meshes.push((name.to_string(), sphere_mesh(2000, center, radius), Some(center)));
+    }
+    if let Some(path) = &options.closed_mesh {
+        // Leaks do not depend on winding or normals: the file is used as is.
+        let mesh = Mesh::load_obj(path, &Transform::default()).map_err(BenchError::Reference)?;
+        let name = path.file_stem().map_or("mesh".into(), |s| s.to_string_lossy().to_string());
+        meshes.push((format!("{name}-obj"), mesh, None));
+    }
+    Ok(meshes)
+}
+
+/// Runs every check on every scene, calling `progress` per row.
+pub fn run(options: &StressOptions, mut progress: impl FnMut(&StressRow)) -> Result<Vec<StressRow>, BenchError> {
+    let mut rows = Vec::new();
+    let mut push = |row: StressRow, rows: &mut Vec<StressRow>| {
+        progress(&row);
+        rows.push(row);
+    };
+    for (name, text) in stress_scenes() {
+        let loaded = load_scene_str(&text, Path::new(name), Path::new("."))?;
+        for kind in IntegratorKind::ALL {
+            if let Some((samples, rejected)) = rejected_samples(&loaded, kind, options) {
+                let row = StressRow {
+                    scene: name.into(),
+                    check: format!("NaN/inf samples ({kind})"),
+                    tested: samples,
+                    failures: rejected,
+                };
+                push(row, &mut rows);
+            }
+        }
+        let (spawned, self_hits) = self_intersections(&loaded.scene, loaded.camera.position, options.rays);
+        push(
+            StressRow {
+                scene: name.into(),
+                check: "self-intersections".into(),
+                tested: spawned,
+                failures: self_hits,
+            },
+            &mut rows,
+        );
+    }
+    for (name, mesh, inside) in closed_meshes(options)? {
+        let (tested, leaked) = leaks(&mesh, inside, options.rays);
+        push(
+            StressRow {
+                scene: name,
+                check: "leaks through closed mesh".into(),
+                tested,
+                failures: leaked,
+            },
+            &mut rows,
+        );
+    }
+    Ok(rows)
+}
+
+/// Writes the counts as CSV.
+pub fn write_results(rows: &[StressRow], options: &StressOptions, machine: &str, path: &Path) -> Result<(), BenchError> {
+    let mut csv = Csv::new(vec!["scene", "check", "tested", "failures"]);
+    csv.comments.push(format!(
+        "prism bench --stress: {}x{} pixels, {} passes per integrator, {} probe rays per scene or mesh",
+        options.width, options.height, options.passes, options.rays
+    ));
+    csv.comments.push("Bezier intersection disagreements: not measured (no Bezier revolution shape in this build)".into());
+    csv.comments.push(machine.to_string());
+    for r in rows {
+        csv.rows.push(vec![r.scene.clone(), r.check.clone(), r.tested.to_string(), r.failures.to_string()]);
+    }
+    csv.write(path)
+}

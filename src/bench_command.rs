@@ -1,0 +1,200 @@
+//! `prism bench`: error against time (default), `--make-references`,
+//! `--scaling` and `--stress`. Argument handling and progress lines only; the
+//! measurements live in the library's `bench` module.
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use prism::bench::{self, error_curves, scaling, stress};
+use prism::output::load_frame;
+use prism::scene::{self, LoadedScene};
+use std::path::{Path, PathBuf};
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Scene files (default: every scenes/*.toml).
+    scenes: Vec<PathBuf>,
+    /// Directory of the small reference images (<scene stem>.exr).
+    #[arg(long, default_value = "references")]
+    references: PathBuf,
+    /// Where the CSV tables and PNG plots go.
+    #[arg(long, default_value = "docs")]
+    output_dir: PathBuf,
+    /// Last rung of the time ladder, in seconds of rendering.
+    #[arg(long, default_value_t = 64.0)]
+    max_seconds: f64,
+    /// First rung; the ladder doubles from here up to --max-seconds.
+    #[arg(long, default_value_t = 1.0)]
+    min_seconds: f64,
+    /// Worker threads for every render.
+    #[arg(long, default_value_t = 2)]
+    threads: usize,
+    /// Noise threshold of the adaptive-sampling configuration.
+    #[arg(long, default_value_t = 0.05)]
+    adaptive_threshold: f64,
+    /// Only these configurations (comma-separated names as in the CSV, e.g. pt/sobol,pt-bsdf/sobol).
+    #[arg(long, value_delimiter = ',')]
+    configurations: Vec<String>,
+    /// Render each scene's reference for this many seconds instead of benchmarking.
+    #[arg(long, value_name = "SECONDS")]
+    make_references: Option<f64>,
+    /// Width of rendered references, in pixels (height follows the scene's aspect).
+    #[arg(long, default_value_t = 256)]
+    reference_width: u32,
+    /// Measure BVH build, ray cost and render time scaling instead.
+    #[arg(long)]
+    scaling: bool,
+    /// Largest triangle count of the scaling run (from 1024, ×4 per step).
+    #[arg(long, default_value_t = 1 << 20)]
+    max_triangles: u32,
+    /// Run the long numerical stress test instead.
+    #[arg(long)]
+    stress: bool,
+    /// Passes per integrator and scene in --stress.
+    #[arg(long, default_value_t = 64)]
+    stress_passes: u32,
+    /// Probe rays per scene or mesh in --stress.
+    #[arg(long, default_value_t = 200_000)]
+    stress_rays: u64,
+}
+
+pub fn bench_command(args: BenchArgs) -> Result<()> {
+    if args.threads == 0 {
+        bail!("--threads must be at least 1");
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads)
+        .build()
+        .context("cannot start worker threads")?;
+    pool.install(|| {
+        if args.stress {
+            stress_command(&args)
+        } else if args.scaling {
+            scaling_command(&args)
+        } else if let Some(seconds) = args.make_references {
+            references_command(&args, seconds)
+        } else {
+            curves_command(&args)
+        }
+    })
+}
+
+/// The scene files named, or every scenes/*.toml.
+fn scene_files(args: &BenchArgs) -> Result<Vec<PathBuf>> {
+    if !args.scenes.is_empty() {
+        return Ok(args.scenes.clone());
+    }
+    let mut files: Vec<PathBuf> = std::fs::read_dir("scenes")
+        .context("no scene files given and no scenes/ directory here")?
+        .filter_map(|entry| entry.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    files.sort();
+    Ok(files)
+}
+
+fn stem(path: &Path) -> String {
+    path.file_stem().map_or("scene".into(), |s| s.to_string_lossy().to_string())
+}
+
+fn references_command(args: &BenchArgs, seconds: f64) -> Result<()> {
+    if !(seconds.is_finite() && seconds > 0.0) || args.reference_width == 0 {
+        bail!("--make-references needs a positive number of seconds and --reference-width at least 1");
+    }
+    for file in scene_files(args)? {
+        let loaded = scene::load_scene_file(&file)?;
+        let settings = error_curves::reference_settings(&loaded.settings, args.reference_width, seconds);
+        let path = error_curves::reference_path(&args.references, &file);
+        eprintln!("{}: rendering {}x{} for {seconds} s ...", file.display(), settings.width, settings.height);
+        let passes = error_curves::make_reference(&loaded, &settings, &path)?;
+        eprintln!("wrote {} ({passes} samples per pixel, seed {})", path.display(), settings.seed);
+    }
+    Ok(())
+}
+
+fn curves_command(args: &BenchArgs) -> Result<()> {
+    if !(args.min_seconds > 0.0 && args.max_seconds >= args.min_seconds) {
+        bail!("need 0 < --min-seconds <= --max-seconds");
+    }
+    let ladder = error_curves::time_ladder(args.min_seconds, args.max_seconds);
+    let mut configurations = error_curves::Configuration::standard(args.adaptive_threshold);
+    if !args.configurations.is_empty() {
+        configurations.retain(|c| args.configurations.contains(&c.name));
+        if configurations.is_empty() {
+            bail!("no configuration matches; names are {:?}", error_curves::Configuration::standard(args.adaptive_threshold).iter().map(|c| c.name.clone()).collect::<Vec<_>>());
+        }
+    }
+    for file in scene_files(args)? {
+        let name = stem(&file);
+        let loaded: LoadedScene = scene::load_scene_file(&file)?;
+        let reference_file = error_curves::reference_path(&args.references, &file);
+        let reference = load_frame(&reference_file).map_err(|e| {
+            anyhow::anyhow!("{e}\n(make it with: prism bench {} --make-references 600)", file.display())
+        })?;
+        eprintln!("{name}: {} configurations, ladder {ladder:?} s, {}x{}", configurations.len(), reference.width, reference.height);
+        let machine_before = bench::machine_note();
+        let curves = error_curves::measure_scene(&name, &loaded, &reference, &configurations, &ladder, |configuration, outcome| match outcome {
+            error_curves::CurveOutcome::Skipped(reason) => eprintln!("  {}: skipped: {reason}", configuration.name),
+            error_curves::CurveOutcome::Measured(points) => {
+                let line: Vec<String> = points.iter().map(|p| format!("{:.1}s:{:.4}", p.elapsed_seconds, p.metrics.rmse)).collect();
+                eprintln!("  {:<24} RMSE {}", configuration.name, line.join(" "));
+            }
+        })?;
+        let machine = format!("before: {machine_before}; after: {}", bench::machine_note());
+        let csv_path = args.output_dir.join(format!("error_{name}.csv"));
+        let png_path = args.output_dir.join(format!("error_{name}.png"));
+        curves.csv(&machine, args.threads).write(&csv_path)?;
+        curves.plot().write_png(&png_path)?;
+        eprintln!("wrote {} and {}", csv_path.display(), png_path.display());
+    }
+    Ok(())
+}
+
+fn scaling_command(args: &BenchArgs) -> Result<()> {
+    let mut counts = Vec::new();
+    let mut n = 1024u32;
+    while n <= args.max_triangles {
+        counts.push(n);
+        n = n.saturating_mul(4);
+    }
+    eprintln!("BVH: {counts:?} triangles");
+    let bvh_rows = scaling::measure_bvh(&counts, 200_000, |r| {
+        eprintln!("  {:>8} triangles: build {:.4} s, {:.0} ns/ray, {:.0}% hit", r.triangles, r.build_seconds, r.ns_per_ray, 100.0 * r.hit_fraction)
+    });
+    scaling::write_bvh_results(&bvh_rows, &bench::machine_note(), &args.output_dir)?;
+
+    let file = scene_files(args)?.into_iter().next();
+    let loaded = match &file {
+        Some(path) => scene::load_scene_file(path)?,
+        None => scene::load_scene_str(scene::DEFAULT_SCENE, Path::new("<default scene>"), Path::new("."))?,
+    };
+    let name = file.as_deref().map_or("cornell".into(), stem);
+    let threads: Vec<usize> = (1..=args.threads.min(2)).collect();
+    eprintln!("render: {name}, threads {threads:?}");
+    let render_rows = scaling::measure_render(&loaded.scene, &loaded.camera, &loaded.settings, &[64, 128, 256, 512], &threads, 4, |r| {
+        eprintln!("  {}x{} {} thread(s): {:.3} s, {:.0} ns/sample", r.width, r.height, r.threads, r.seconds, r.ns_per_sample)
+    })?;
+    scaling::write_render_results(&render_rows, &name, &bench::machine_note(), &args.output_dir)?;
+    eprintln!("wrote bvh_scaling.csv, bvh_build.png, ray_cost.png, render_scaling.csv, render_scaling.png in {}", args.output_dir.display());
+    Ok(())
+}
+
+fn stress_command(args: &BenchArgs) -> Result<()> {
+    let bunny = PathBuf::from("assets/bunny.obj");
+    let options = stress::StressOptions {
+        width: 128,
+        height: 128,
+        passes: args.stress_passes,
+        rays: args.stress_rays,
+        closed_mesh: bunny.exists().then_some(bunny),
+        photons_per_iteration: 100_000,
+    };
+    let rows = stress::run(&options, |r| eprintln!("  {:<32} {:<26} {:>10} tested, {} failures", r.scene, r.check, r.tested, r.failures))?;
+    let path = args.output_dir.join("stress.csv");
+    stress::write_results(&rows, &options, &bench::machine_note(), &path)?;
+    let failures: u64 = rows.iter().map(|r| r.failures).sum();
+    eprintln!("wrote {}; {failures} failures in total", path.display());
+    if failures > 0 {
+        bail!("{failures} stress failures");
+    }
+    Ok(())
+}

@@ -1,0 +1,615 @@
+//! Bezier curves and polynomials in Bernstein form: evaluation (de Casteljau),
+//! derivatives, products, subdivision, and real-root isolation on `[0, 1]`.
+//!
+//! A polynomial of degree `n` is stored as its Bernstein coefficients
+//! `c_0 … c_n`, `p(t) = Σ c_k C(n,k) t^k (1−t)^(n−k)` (Farin, "Curves and
+//! Surfaces for CAGD", ch. 5). Three properties carry the whole module:
+//! - the values at the ends are `c_0` and `c_n` exactly;
+//! - the curve lies in the convex hull of its coefficients, so if every
+//!   coefficient has the same sign there is no root (de Casteljau's
+//!   subdivision keeps this true on every sub-interval);
+//! - Descartes' rule of signs holds in Bernstein form: the number of roots in
+//!   the open interval is at most the number of sign variations `V` of the
+//!   coefficients and has the same parity, so `V = 1` proves exactly one root
+//!   (Lane and Riesenfeld 1981; Mourrain, Rouillier and Roy 2005).
+//!
+//! Root isolation (`isolate_roots`) is the Bernstein subdivision method built
+//! on those facts, with floating-point error bounds on the coefficients so a
+//! sign is trusted only when it exceeds its error. A piece with `V = 1` and
+//! end values of opposite sign is polished with safeguarded Newton iteration
+//! (Newton inside a shrinking bisection bracket, so it always converges).
+//! Pieces narrower than a minimum width that still may hold a root are
+//! reported as clusters (double or nearly double roots, tangencies).
+
+use crate::math::gamma;
+use glam::DVec2;
+
+/// Most control points one Bezier segment may have.
+pub const MAX_CONTROL_POINTS: usize = 16;
+/// Highest degree of a segment's curve.
+pub const MAX_DEGREE: usize = MAX_CONTROL_POINTS - 1;
+/// Coefficients of a product of two polynomials of degree `MAX_DEGREE`.
+pub const MAX_COEFFICIENTS: usize = 2 * MAX_DEGREE + 1;
+
+/// Pascal's triangle up to row `2 · MAX_DEGREE`; every entry is exact in `f64`.
+const BINOMIAL: [[f64; MAX_COEFFICIENTS]; MAX_COEFFICIENTS] = binomial_table();
+
+const fn binomial_table() -> [[f64; MAX_COEFFICIENTS]; MAX_COEFFICIENTS] {
+    let mut table = [[0.0; MAX_COEFFICIENTS]; MAX_COEFFICIENTS];
+    let mut n = 0;
+    while n < MAX_COEFFICIENTS {
+        table[n][0] = 1.0;
+        let mut k = 1;
+        while k <= n {
+            table[n][k] = table[n - 1][k - 1] + if k < n { table[n - 1][k] } else { 0.0 };
+            k += 1;
+        }
+        n += 1;
+    }
+    table
+}
+
+/// The binomial coefficient `C(n, k)` for `n ≤ 2 · MAX_DEGREE`.
+pub fn binomial(n: usize, k: usize) -> f64 {
+    if k > n { 0.0 } else { BINOMIAL[n][k] }
+}
+
+// ---------------------------------------------------------------------------
+// Planar Bezier curves.
+
+/// The point of the curve at `t` (de Casteljau).
+pub fn evaluate(points: &[DVec2], t: f64) -> DVec2 {
+    evaluate_with_derivative(points, t).0
+}
+
+/// The point and the first derivative `dc/dt` at `t`. The derivative comes
+/// from the last de Casteljau level: `c'(t) = n (b₁ − b₀)` (Farin, eq. 5.20).
+pub fn evaluate_with_derivative(points: &[DVec2], t: f64) -> (DVec2, DVec2) {
+    let count = points.len().min(MAX_CONTROL_POINTS);
+    let mut level = [DVec2::ZERO; MAX_CONTROL_POINTS];
+    level[..count].copy_from_slice(&points[..count]);
+    if count == 1 {
+        return (level[0], DVec2::ZERO);
+    }
+    for width in (2..count).rev() {
+        for i in 0..width {
+            level[i] = level[i].lerp(level[i + 1], t);
+        }
+    }
+    let degree = (count - 1) as f64;
+    (level[0].lerp(level[1], t), degree * (level[1] - level[0]))
+}
+
+/// Control points of the derivative curve (the hodograph), `n (P_{i+1} − P_i)`.
+pub fn hodograph(points: &[DVec2]) -> Vec<DVec2> {
+    let degree = points.len().saturating_sub(1) as f64;
+    points.windows(2).map(|pair| degree * (pair[1] - pair[0])).collect()
+}
+
+/// Splits the curve at `t` into the control polygons of `[0, t]` and `[t, 1]`.
+pub fn split(points: &[DVec2], t: f64) -> (Vec<DVec2>, Vec<DVec2>) {
+    let mut level = points.to_vec();
+    let mut left = Vec::with_capacity(points.len());
+    let mut right = Vec::with_capacity(points.len());
+    while let Some(&first) = level.first() {
+        left.push(first);
+        right.push(*level.last().unwrap_or(&first));
+        level = level.windows(2).map(|pair| pair[0].lerp(pair[1], t)).collect();
+    }
+    right.reverse();
+    (left, right)
+}
+
+/// Unit direction of travel of the curve at `t`, also where `c'(t) = 0`.
+///
+/// If the first `k − 1` derivatives vanish at `t₀`, Taylor's theorem gives
+/// `c'(t) ≈ c⁽ᵏ⁾(t₀) (t − t₀)^(k−1) / (k−1)!`, so the direction is that of the
+/// first non-zero derivative, reversed for odd `k − 1` when the curve arrives
+/// at `t₀` from below (we take the side inside `[0, 1]`: from below at
+/// `t > ½`). `None` only for a curve collapsed to one point.
+pub fn tangent_direction(points: &[DVec2], t: f64) -> Option<DVec2> {
+    let size = points.iter().fold(0.0_f64, |m, p| m.max(p.abs().max_element()));
+    let degree = points.len().saturating_sub(1);
+    // Common case first, without building the hodographs.
+    let (_, first_derivative) = evaluate_with_derivative(points, t);
+    let first_noise = gamma(4 * MAX_CONTROL_POINTS as u32) * 2.0 * degree as f64 * size;
+    if first_derivative.length() > first_noise {
+        return Some(first_derivative.normalize());
+    }
+    let mut derivative_points = hodograph(points);
+    let mut order = 1;
+    // Scale of the k-th derivative's control points, n!/(n−k)! · 2^k · size.
+    let mut scale = size;
+    while !derivative_points.is_empty() {
+        scale *= 2.0 * (degree + 1 - order) as f64;
+        let derivative = evaluate(&derivative_points, t);
+        // Below this the derivative is rounding noise of differences of points.
+        let noise = gamma(4 * MAX_CONTROL_POINTS as u32) * scale;
+        if derivative.length() > noise {
+            let from_below = t > 0.5 && order % 2 == 0;
+            let direction = derivative.normalize();
+            return Some(if from_below { -direction } else { direction });
+        }
+        derivative_points = hodograph(&derivative_points);
+        order += 1;
+    }
+    None
+}
+
+// ---------------------------------------------------------------------------
+// Scalar polynomials in Bernstein form, on coefficient slices.
+
+/// `p(t)` by de Casteljau's algorithm (backward stable, Farouki and Rajan 1987).
+pub fn bernstein_evaluate(coefficients: &[f64], t: f64) -> f64 {
+    bernstein_evaluate_with_derivative(coefficients, t).0
+}
+
+/// `p(t)` and `p'(t)`; the derivative is `n (b₁ − b₀)` at the last level.
+pub fn bernstein_evaluate_with_derivative(coefficients: &[f64], t: f64) -> (f64, f64) {
+    let count = coefficients.len();
+    assert!(
+        count <= MAX_COEFFICIENTS,
+        "Bernstein polynomial of degree above {}",
+        MAX_COEFFICIENTS - 1
+    );
+    if count == 0 {
+        return (0.0, 0.0);
+    }
+    if count == 1 {
+        return (coefficients[0], 0.0);
+    }
+    let mut level = [0.0; MAX_COEFFICIENTS];
+    level[..count].copy_from_slice(coefficients);
+    let s = 1.0 - t;
+    for width in (2..count).rev() {
+        for i in 0..width {
+            level[i] = s * level[i] + t * level[i + 1];
+        }
+    }
+    let degree = (count - 1) as f64;
+    (s * level[0] + t * level[1], degree * (level[1] - level[0]))
+}
+
+/// Splits at `t = ½`: `left` and `right` receive the coefficients over
+/// `[0, ½]` and `[½, 1]`, each re-parameterised to `[0, 1]`.
+pub fn bernstein_split_half(coefficients: &[f64], left: &mut [f64], right: &mut [f64]) {
+    bernstein_split(coefficients, 0.5, left, right);
+}
+
+/// Splits at `t` (de Casteljau's triangle: its left edge is the left piece,
+/// its right edge the right piece).
+pub fn bernstein_split(coefficients: &[f64], t: f64, left: &mut [f64], right: &mut [f64]) {
+    let count = coefficients.len();
+    assert!(count <= MAX_COEFFICIENTS && left.len() >= count && right.len() >= count);
+    let mut level = [0.0; MAX_COEFFICIENTS];
+    level[..count].copy_from_slice(coefficients);
+    let s = 1.0 - t;
+    for step in 0..count {
+        left[step] = level[0];
+        right[count - 1 - step] = level[count - 1 - step];
+        for i in 0..count - 1 - step {
+            level[i] = s * level[i] + t * level[i + 1];
+        }
+    }
+}
+
+/// Product of two Bernstein polynomials of degrees `m` and `n` into `out`
+/// (length `m + n + 1`):
+/// `c_k = Σ_{i+j=k} C(m,i) C(n,j) a_i b_j / C(m+n,k)` (Farouki and Rajan 1988).
+pub fn bernstein_product(a: &[f64], b: &[f64], out: &mut [f64]) {
+    let (m, n) = (a.len() - 1, b.len() - 1);
+    assert!(m + n < MAX_COEFFICIENTS && out.len() > m + n);
+    out[..=m + n].fill(0.0);
+    for (i, &ai) in a.iter().enumerate() {
+        let weighted = ai * binomial(m, i);
+        for (j, &bj) in b.iter().enumerate() {
+            out[i + j] += weighted * binomial(n, j) * bj;
+        }
+    }
+    for (k, value) in out[..=m + n].iter_mut().enumerate() {
+        *value /= binomial(m + n, k);
+    }
+}
+
+/// `p^k` in Bernstein form (degree `k n`, at most `MAX_COEFFICIENTS − 1`).
+pub fn bernstein_power(coefficients: &[f64], power: usize) -> Vec<f64> {
+    let mut result = vec![1.0];
+    for _ in 0..power {
+        let mut next = vec![0.0; result.len() + coefficients.len() - 1];
+        bernstein_product(&result, coefficients, &mut next);
+        result = next;
+    }
+    result
+}
+
+/// Number of sign changes in the sequence, skipping exact zeros.
+pub fn sign_variations(coefficients: &[f64]) -> usize {
+    let mut previous = 0.0;
+    let mut variations = 0;
+    for &c in coefficients.iter().filter(|c| **c != 0.0) {
+        if previous != 0.0 && (c > 0.0) != (previous > 0.0) {
+            variations += 1;
+        }
+        previous = c;
+    }
+    variations
+}
+
+// ---------------------------------------------------------------------------
+// Root isolation.
+
+/// A polynomial restricted to a parameter interval, as root isolation sees
+/// it. The local parameter `τ ∈ [0, 1]` maps linearly onto the interval.
+pub trait PolynomialPiece: Sized {
+    /// Writes the Bernstein coefficients over this piece into `out` and
+    /// returns their count and an absolute bound on their rounding error.
+    fn coefficients(&self, out: &mut [f64; MAX_COEFFICIENTS]) -> (usize, f64);
+    /// The two halves `τ ∈ [0, ½]` and `[½, 1]`.
+    fn split_half(&self) -> (Self, Self);
+    /// The polynomial and its `τ`-derivative at local parameter `τ`.
+    fn evaluate_with_derivative(&self, tau: f64) -> (f64, f64);
+}
+
+/// One root (or cluster of roots) found by `isolate_roots`.
+#[derive(Clone, Copy, Debug)]
+pub struct IsolatedRoot {
+    /// Local parameter in the piece that holds the root.
+    pub tau: f64,
+    /// Global parameter in `[0, 1]`.
+    pub t: f64,
+    /// Half-width of the interval of `t` known to hold the root.
+    pub t_uncertainty: f64,
+    /// The root could not be separated from its neighbours (a tangency).
+    pub is_cluster: bool,
+}
+
+/// Upper limit on the pieces one call examines: a polynomial that vanishes
+/// identically would otherwise be split down to the minimum width everywhere.
+const PIECE_BUDGET: usize = 4096;
+
+/// Finds every real root of the piece's polynomial in `τ ∈ [0, 1]`
+/// (mapped to `t ∈ [t0, t1]`) and reports each, left to right, to `on_root`
+/// with the piece that holds it. Pieces narrower than `minimum_width` (in
+/// `t`) that may still hold roots are reported once as a cluster at their
+/// midpoint, as is a piece on which the polynomial is zero within its
+/// error bound.
+pub fn isolate_roots<P: PolynomialPiece>(
+    piece: &P,
+    t0: f64,
+    t1: f64,
+    minimum_width: f64,
+    on_root: &mut impl FnMut(&P, IsolatedRoot),
+) {
+    let mut coefficients = [0.0; MAX_COEFFICIENTS];
+    let (count, _) = piece.coefficients(&mut coefficients);
+    // Roots exactly at the ends of the whole interval; inner split points are
+    // reported where they are created.
+    if count > 0 && coefficients[0] == 0.0 {
+        on_root(piece, exact_root(0.0, t0, t0, t1));
+    }
+    let mut budget = PIECE_BUDGET;
+    isolate_recursive(piece, t0, t1, minimum_width, &mut budget, on_root);
+    if count > 0 && coefficients[count - 1] == 0.0 {
+        on_root(piece, exact_root(1.0, t1, t0, t1));
+    }
+}
+
+fn exact_root(tau: f64, t: f64, t0: f64, t1: f64) -> IsolatedRoot {
+    IsolatedRoot {
+        tau,
+        t,
+        t_uncertainty: f64::EPSILON * (t0.abs() + t1.abs()),
+        is_cluster: false,
+    }
+}
+
+fn isolate_recursive<P: PolynomialPiece>(
+    piece: &P,
+    t0: f64,
+    t1: f64,
+    minimum_width: f64,
+    budget: &mut usize,
+    on_root: &mut impl FnMut(&P, IsolatedRoot),
+) {
+    if *budget == 0 {
+        return;
+    }
+    *budget -= 1;
+    let mut buffer = [0.0; MAX_COEFFICIENTS];
+    let (count, error) = piece.coefficients(&mut buffer);
+    if count == 0 {
+        return;
+    }
+    let coefficients = &buffer[..count];
+    let (first, last) = (coefficients[0], coefficients[count - 1]);
+
+    // Step 1: discard the piece if every coefficient (ignoring exact zeros at
+    // the ends, which are roots at the ends reported elsewhere) has a certain
+    // sign, the same for all.
+    let leading_zeros = coefficients.iter().take_while(|&&c| c == 0.0).count();
+    let trailing_zeros = coefficients[leading_zeros..].iter().rev().take_while(|&&c| c == 0.0).count();
+    let inner = &coefficients[leading_zeros..count - trailing_zeros];
+    let all_positive = inner.iter().all(|&c| c > error);
+    let all_negative = inner.iter().all(|&c| c < -error);
+    if inner.is_empty() || all_positive || all_negative {
+        return;
+    }
+    let width = t1 - t0;
+
+    // Step 2: the polynomial is zero within its error on the whole piece (a
+    // tangency below the rounding level, or a ray running inside the
+    // surface): one cluster for the whole piece, no further splitting.
+    if inner.iter().all(|&c| c.abs() <= error) {
+        on_root(
+            piece,
+            IsolatedRoot {
+                tau: 0.5,
+                t: t0 + 0.5 * width,
+                t_uncertainty: 0.5 * width,
+                is_cluster: true,
+            },
+        );
+        return;
+    }
+
+    // Step 3: exactly one root, bracketed by end values of opposite sign.
+    if sign_variations(coefficients) == 1 && first * last < 0.0 {
+        let (tau, tau_uncertainty) = polish_root(piece, first, last);
+        on_root(
+            piece,
+            IsolatedRoot {
+                tau,
+                t: t0 + tau * width,
+                t_uncertainty: tau_uncertainty * width + f64::EPSILON * t1.abs(),
+                is_cluster: false,
+            },
+        );
+        return;
+    }
+
+    // Step 4: too narrow to split further: a cluster of roots or a tangency.
+    let middle = t0 + 0.5 * width;
+    if width <= minimum_width || middle <= t0 || middle >= t1 {
+        on_root(
+            piece,
+            IsolatedRoot {
+                tau: 0.5,
+                t: middle,
+                t_uncertainty: 0.5 * width,
+                is_cluster: true,
+            },
+        );
+        return;
+    }
+
+    // Step 5: split in half and recurse, left first; a root exactly at the
+    // split point is reported once, here.
+    let (left, right) = piece.split_half();
+    isolate_recursive(&left, t0, middle, minimum_width, budget, on_root);
+    let mut right_coefficients = [0.0; MAX_COEFFICIENTS];
+    let (right_count, _) = right.coefficients(&mut right_coefficients);
+    if right_count > 0 && right_coefficients[0] == 0.0 {
+        on_root(&right, exact_root(0.0, middle, t0, t1));
+    }
+    isolate_recursive(&right, middle, t1, minimum_width, budget, on_root);
+}
+
+/// Safeguarded Newton iteration on `τ ∈ [0, 1]` where `p(0) = value_at_0` and
+/// `p(1) = value_at_1` have opposite signs (Numerical Recipes' `rtsafe`):
+/// a Newton step is taken when it stays inside the bracket and at least
+/// halves the previous step, otherwise the bracket is bisected. Returns the
+/// root and a bound on its distance to the true root of the computed `p`.
+fn polish_root<P: PolynomialPiece>(piece: &P, value_at_0: f64, value_at_1: f64) -> (f64, f64) {
+    let (mut low, mut high) = (0.0_f64, 1.0_f64);
+    let low_is_negative = value_at_0 < 0.0;
+    // Start from the secant (regula falsi) point, well inside the bracket.
+    let mut tau = (value_at_0 / (value_at_0 - value_at_1)).clamp(0.05, 0.95);
+    let mut previous_step = 1.0_f64;
+    for _ in 0..200 {
+        let (value, derivative) = piece.evaluate_with_derivative(tau);
+        if value == 0.0 {
+            return (tau, f64::EPSILON);
+        }
+        if (value < 0.0) == low_is_negative {
+            low = tau;
+        } else {
+            high = tau;
+        }
+        let newton = tau - value / derivative;
+        let step_ok = newton.is_finite() && newton > low && newton < high && (newton - tau).abs() < 0.5 * previous_step;
+        let next = if step_ok { newton } else { 0.5 * (low + high) };
+        let step = (next - tau).abs();
+        previous_step = step;
+        tau = next;
+        // Converged: the step is at the rounding level of τ, or the bracket
+        // has closed.
+        if step <= 2.0 * f64::EPSILON * tau.abs().max(f64::MIN_POSITIVE) || high - low <= 4.0 * f64::EPSILON {
+            return (tau, (2.0 * step).max(4.0 * f64::EPSILON).min(high - low));
+        }
+    }
+    (tau, high - low)
+}
+
+/// A plain Bernstein polynomial as a `PolynomialPiece`, carrying the error
+/// bound accumulated by subdivision.
+#[derive(Clone, Copy, Debug)]
+pub struct BernsteinPiece {
+    coefficients: [f64; MAX_COEFFICIENTS],
+    count: usize,
+    error: f64,
+}
+
+impl BernsteinPiece {
+    /// A piece over `[0, 1]` whose coefficients are known to within `error`.
+    pub fn new(coefficients: &[f64], error: f64) -> Self {
+        assert!(!coefficients.is_empty() && coefficients.len() <= MAX_COEFFICIENTS);
+        let mut stored = [0.0; MAX_COEFFICIENTS];
+        stored[..coefficients.len()].copy_from_slice(coefficients);
+        Self {
+            coefficients: stored,
+            count: coefficients.len(),
+            error,
+        }
+    }
+
+    /// The coefficients over this piece.
+    pub fn coefficient_slice(&self) -> &[f64] {
+        &self.coefficients[..self.count]
+    }
+}
+
+impl PolynomialPiece for BernsteinPiece {
+    fn coefficients(&self, out: &mut [f64; MAX_COEFFICIENTS]) -> (usize, f64) {
+        out[..self.count].copy_from_slice(self.coefficient_slice());
+        (self.count, self.error)
+    }
+
+    fn split_half(&self) -> (Self, Self) {
+        let mut left = *self;
+        let mut right = *self;
+        bernstein_split_half(self.coefficient_slice(), &mut left.coefficients, &mut right.coefficients);
+        // Each level adds at most n roundings of averages of the coefficients.
+        let largest = self.coefficient_slice().iter().fold(0.0_f64, |m, c| m.max(c.abs()));
+        let added = gamma(self.count as u32) * largest;
+        left.error += added;
+        right.error += added;
+        (left, right)
+    }
+
+    fn evaluate_with_derivative(&self, tau: f64) -> (f64, f64) {
+        bernstein_evaluate_with_derivative(self.coefficient_slice(), tau)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Bernstein coefficients of `Π (t − r_i)`, built by products of linear factors.
+    fn from_roots(roots: &[f64]) -> Vec<f64> {
+        let mut result = vec![1.0];
+        for &root in roots {
+            let mut next = vec![0.0; result.len() + 1];
+            bernstein_product(&result, &[-root, 1.0 - root], &mut next);
+            result = next;
+        }
+        result
+    }
+
+    fn roots_of(coefficients: &[f64]) -> Vec<IsolatedRoot> {
+        let mut found = Vec::new();
+        let error = gamma(4 * coefficients.len() as u32) * coefficients.iter().fold(0.0_f64, |m, c| m.max(c.abs()));
+        isolate_roots(&BernsteinPiece::new(coefficients, error), 0.0, 1.0, 1e-13, &mut |_, root| {
+            found.push(root)
+        });
+        found
+    }
+
+    #[test]
+    fn binomials_match_pascal() {
+        assert_eq!(binomial(4, 2), 6.0);
+        assert_eq!(binomial(30, 15), 155_117_520.0);
+        assert_eq!(binomial(3, 5), 0.0);
+    }
+
+    #[test]
+    fn de_casteljau_matches_power_form() {
+        // Cubic with control points on y = t³ in Bernstein form: (0, 0, 0, 1).
+        let points = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(1.0, 0.0),
+            DVec2::new(2.0, 0.0),
+            DVec2::new(3.0, 1.0),
+        ];
+        for t in [0.0, 0.25, 0.5, 0.9, 1.0] {
+            let (point, derivative) = evaluate_with_derivative(&points, t);
+            assert!((point - DVec2::new(3.0 * t, t * t * t)).length() < 1e-15);
+            assert!((derivative - DVec2::new(3.0, 3.0 * t * t)).length() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn split_pieces_reproduce_the_curve() {
+        let points = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(2.0, 1.0),
+            DVec2::new(-1.0, 3.0),
+            DVec2::new(1.0, 1.0),
+        ];
+        let (left, right) = split(&points, 0.3);
+        for u in [0.0, 0.4, 1.0] {
+            assert!((evaluate(&left, u) - evaluate(&points, 0.3 * u)).length() < 1e-14);
+            assert!((evaluate(&right, u) - evaluate(&points, 0.3 + 0.7 * u)).length() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn products_and_powers_evaluate_as_products() {
+        let a = [0.3, -1.0, 2.0];
+        let b = [1.0, 0.5, -0.25, 4.0];
+        let mut product = [0.0; 6];
+        bernstein_product(&a, &b, &mut product);
+        let cube = bernstein_power(&a, 3);
+        for t in [0.0, 0.2, 0.7, 1.0] {
+            let (pa, pb) = (bernstein_evaluate(&a, t), bernstein_evaluate(&b, t));
+            assert!((bernstein_evaluate(&product, t) - pa * pb).abs() < 1e-14);
+            assert!((bernstein_evaluate(&cube, t) - pa * pa * pa).abs() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn derivative_matches_finite_difference() {
+        let c = [0.3, -1.0, 2.0, 0.1, -0.7];
+        let (_, derivative) = bernstein_evaluate_with_derivative(&c, 0.37);
+        let h = 1e-6;
+        let numeric = (bernstein_evaluate(&c, 0.37 + h) - bernstein_evaluate(&c, 0.37 - h)) / (2.0 * h);
+        assert!((derivative - numeric).abs() < 1e-8);
+    }
+
+    #[test]
+    fn isolates_close_simple_roots() {
+        let roots = [0.1, 0.1 + 1e-6, 0.5, 0.99];
+        let found = roots_of(&from_roots(&roots));
+        assert_eq!(found.len(), 4, "{found:?}");
+        for (root, expected) in found.iter().zip(roots) {
+            assert!(!root.is_cluster);
+            // The pair 1e-6 apart has slope ≈ 4e-7: rounding of 1e-17 in the
+            // value moves its roots by ≈ 1e-11.
+            assert!((root.t - expected).abs() < 1e-10, "{} vs {expected}", root.t);
+        }
+    }
+
+    #[test]
+    fn finds_roots_at_the_ends_and_at_split_points() {
+        let found = roots_of(&from_roots(&[0.0, 0.5, 1.0]));
+        let ts: Vec<f64> = found.iter().map(|r| r.t).collect();
+        assert_eq!(ts, vec![0.0, 0.5, 1.0]);
+    }
+
+    #[test]
+    fn reports_a_double_root_as_a_cluster() {
+        let found = roots_of(&from_roots(&[0.3, 0.3, 0.8]));
+        assert!(found.iter().any(|r| r.is_cluster && (r.t - 0.3).abs() < 1e-7), "{found:?}");
+        assert!(found.iter().any(|r| !r.is_cluster && (r.t - 0.8).abs() < 1e-15));
+    }
+
+    #[test]
+    fn rootless_polynomials_report_nothing() {
+        assert!(roots_of(&[1.0, -0.2, 0.9]).is_empty()); // minimum 0.35 > 0
+        assert!(roots_of(&from_roots(&[-0.5, 1.5])).is_empty());
+    }
+
+    #[test]
+    fn tangent_of_a_curve_with_repeated_end_points_uses_the_next_derivative() {
+        let points = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(0.0, 0.0),
+            DVec2::new(1.0, 0.0),
+            DVec2::new(1.0, 1.0),
+            DVec2::new(1.0, 1.0),
+        ];
+        assert!((tangent_direction(&points, 0.0).expect("defined") - DVec2::X).length() < 1e-15);
+        assert!((tangent_direction(&points, 1.0).expect("defined") - DVec2::Y).length() < 1e-15);
+        assert!(tangent_direction(&[DVec2::ONE, DVec2::ONE], 0.5).is_none());
+    }
+}

@@ -1,0 +1,104 @@
+//! The camera pass of SPPM: one path per pixel, followed through mirror and
+//! glass bounces to the first non-specular surface, where it leaves a
+//! *visible point* (Hachisuka & Jensen 2009, §3: the "hit point" x with its
+//! BSDF, outgoing direction and path weight) for photons to be gathered at.
+//!
+//! Emission met along the specular chain is returned separately; light that
+//! reaches the visible point after any diffuse or glossy reflection is left
+//! entirely to the photons (the classic, consistent split).
+
+use crate::color::Color;
+use crate::material::{ShadingPoint, Transport};
+use crate::math::{DVec3, Frame as ShadingFrame, Ray};
+use crate::sampler::Sampler;
+use crate::scene::Scene;
+
+/// Where one pixel's camera path met its first non-specular surface.
+#[derive(Clone, Copy, Debug)]
+pub struct VisiblePoint {
+    pub point: DVec3,
+    /// Geometric normal as the shape defines it (not flipped towards `wo`).
+    pub geometric_normal: DVec3,
+    pub frame: ShadingFrame,
+    /// Direction back along the camera path, in the local shading frame.
+    pub wo: DVec3,
+    /// Texture coordinates for the material's lookups.
+    pub at: ShadingPoint,
+    /// Index into `scene.materials`.
+    pub material: u32,
+    /// Product of the specular bounces' weights from the camera.
+    pub throughput: Color,
+    /// Distance travelled from the camera: how large a pixel looks here.
+    pub path_length: f64,
+}
+
+impl VisiblePoint {
+    /// Which side of the surface the camera path arrived from (+1 or −1,
+    /// relative to the geometric normal).
+    pub fn side(&self) -> f64 {
+        let wo_world = self.frame.to_world(self.wo);
+        wo_world.dot(self.geometric_normal).signum()
+    }
+}
+
+/// What one camera path found.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct CameraPath {
+    /// Emission seen directly or through specular bounces (already weighted).
+    pub emitted: Color,
+    pub visible_point: Option<VisiblePoint>,
+}
+
+/// Traces `ray` through up to `max_depth` specular bounces.
+pub fn trace_camera_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, max_depth: u32) -> CameraPath {
+    let mut result = CameraPath::default();
+    let mut throughput = Color::ONE;
+    let mut path_length = 0.0;
+    for _ in 0..=max_depth {
+        let Some(intersection) = scene.intersect(&ray, f64::INFINITY) else {
+            result.emitted += throughput * scene.background;
+            break;
+        };
+        let hit = intersection.hit;
+        path_length += hit.t;
+        let material_index = scene.primitives[intersection.primitive as usize].material;
+        let material = &scene.materials[material_index as usize];
+        let wo_world = -ray.direction;
+        // Every vertex here ends a purely specular chain, so emission counts in full.
+        result.emitted += throughput * material.emitted(hit.geometric_normal.dot(wo_world));
+        if !material.scatters() {
+            break;
+        }
+        let frame = ShadingFrame::from_normal(hit.shading_normal);
+        let wo = frame.to_local(wo_world);
+        let at = ShadingPoint {
+            uv: hit.uv,
+            point: hit.point,
+        };
+        if !material.is_specular() {
+            result.visible_point = Some(VisiblePoint {
+                point: hit.point,
+                geometric_normal: hit.geometric_normal,
+                frame,
+                wo,
+                at,
+                material: material_index,
+                throughput,
+                path_length,
+            });
+            break;
+        }
+        // Mirror or glass: follow the one sampled direction.
+        let u = sampler.next_2d();
+        let u_lobe = sampler.next_1d();
+        let Some(sample) = material.sample(wo, &at, u, u_lobe, Transport::Radiance) else {
+            break;
+        };
+        throughput *= sample.weight;
+        if throughput == Color::ZERO {
+            break;
+        }
+        ray = Ray::spawn(hit.point, hit.point_error, hit.geometric_normal, frame.to_world(sample.wi));
+    }
+    result
+}

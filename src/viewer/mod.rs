@@ -1,0 +1,89 @@
+//! The interactive progressive viewer (egui/eframe; egui lives only in this
+//! module). A [`RenderSession`](crate::render::session::RenderSession) renders
+//! on its own thread; the UI thread only sends commands, uploads the latest
+//! frame as a texture and lays out the panels, so it never waits on rendering.
+//!
+//! Every control is classified once (see `docs/viewer.md`): display-only
+//! (exposure, tone map, view) re-maps the current frame; sampling (camera,
+//! integrator, depth, targets, resolution) restarts accumulation and keeps the
+//! `Arc<Scene>`; scene (open, drop, file changed) loads on a background thread,
+//! then restarts.
+
+mod app;
+mod camera_input;
+mod loader;
+mod panels;
+mod texture;
+
+pub use app::{ViewKind, ViewerApp};
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// How the viewer starts.
+#[derive(Clone, Debug)]
+pub struct ViewerStart {
+    /// Scene file; the embedded default scene if `None`.
+    pub scene: Option<PathBuf>,
+    /// Render worker threads (0 = all cores).
+    pub render_threads: usize,
+    /// Initial resolution scale (1 = the scene's own width and height).
+    pub resolution_scale: f32,
+    /// Print timestamped events (first image, restart latency, UI frame
+    /// rate) to stderr and repaint continuously so the frame rate can be measured.
+    pub log: bool,
+}
+
+impl Default for ViewerStart {
+    fn default() -> Self {
+        Self {
+            scene: None,
+            render_threads: 2,
+            resolution_scale: 1.0,
+            log: std::env::var_os("PRISM_VIEWER_LOG").is_some_and(|v| !v.is_empty() && v != "0"),
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum ViewerError {
+    #[error(
+        "no display: neither DISPLAY nor WAYLAND_DISPLAY is set, so the viewer cannot open a window.\n\
+         To render without a window use `prism render [SCENE] --output image.png`."
+    )]
+    NoDisplay,
+    #[error("cannot open the viewer window: {0}\nTo render without a window use `prism render [SCENE] --output image.png`.")]
+    Window(String),
+}
+
+/// Whether a window system is reachable at all (checked before eframe,
+/// which would otherwise fail with a less helpful message or panic).
+pub fn display_available() -> bool {
+    ["DISPLAY", "WAYLAND_DISPLAY"]
+        .iter()
+        .any(|name| std::env::var_os(name).is_some_and(|v| !v.is_empty()))
+}
+
+/// Opens the viewer window and runs until it is closed.
+pub fn run(initial: ViewerStart) -> Result<(), ViewerError> {
+    if !display_available() {
+        return Err(ViewerError::NoDisplay);
+    }
+    let launched = Instant::now();
+    let options = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_title("Prism")
+            .with_inner_size([1200.0, 760.0])
+            .with_drag_and_drop(true),
+        ..Default::default()
+    };
+    eframe::run_native(
+        "Prism",
+        options,
+        Box::new(move |creation| {
+            let app = ViewerApp::new(&creation.egui_ctx, initial, launched)?;
+            Ok(Box::new(app))
+        }),
+    )
+    .map_err(|error| ViewerError::Window(error.to_string()))
+}

@@ -1,0 +1,249 @@
+//! The viewer driven through egui_kittest (no window, real render thread):
+//! the aperture slider reaches the render thread and restarts accumulation,
+//! clicking the image focuses on the clicked surface, saving writes a valid
+//! image with metadata, and a broken scene shows its error in the window.
+//!
+//! The renders run at 1/8 of the default scene's resolution (64 × 64) on one
+//! worker thread, so each test takes a few seconds in a debug build.
+
+use egui::accesskit::Role;
+use egui::{Event, Modifiers, PointerButton, Pos2, Vec2};
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use glam::DVec2;
+use prism::render::session::SessionState;
+use prism::scene;
+use prism::viewer::{ViewerApp, ViewerStart};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// Generous: a loaded CI machine running other tests in parallel.
+const TIMEOUT: Duration = Duration::from_secs(60);
+
+fn start(scene: Option<PathBuf>) -> Harness<'static, ViewerApp> {
+    let start = ViewerStart {
+        scene,
+        render_threads: 1,
+        resolution_scale: 0.125,
+        log: false,
+    };
+    // The render thread's wake-ups go to a context of their own: the test steps the UI itself.
+    let app = ViewerApp::new(&egui::Context::default(), start, Instant::now()).expect("viewer starts");
+    Harness::builder()
+        .with_size(Vec2::new(1100.0, 720.0))
+        .build_ui_state(|ui, app: &mut ViewerApp| app.show(ui), app)
+}
+
+/// Steps the UI until `done` holds, failing after `TIMEOUT`.
+fn step_until(harness: &mut Harness<'static, ViewerApp>, what: &str, done: impl Fn(&ViewerApp) -> bool) {
+    let begun = Instant::now();
+    while !done(harness.state()) {
+        assert!(begun.elapsed() < TIMEOUT, "timed out waiting for {what}");
+        harness.step();
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
+fn temporary_path(name: &str) -> PathBuf {
+    std::env::temp_dir().join(format!("prism-viewer-test-{}-{name}", std::process::id()))
+}
+
+fn press(harness: &Harness<'static, ViewerApp>, position: Pos2, pressed: bool) {
+    harness.event(Event::PointerButton {
+        pos: position,
+        button: PointerButton::Primary,
+        pressed,
+        modifiers: Modifiers::NONE,
+    });
+}
+
+#[test]
+fn aperture_slider_changes_the_render_threads_camera_and_restarts() {
+    let mut harness = start(None);
+    // Let the first generation accumulate a few passes.
+    step_until(&mut harness, "a few passes", |app| {
+        app.displayed_frame().is_some_and(|f| f.passes >= 2)
+    });
+    let before = harness.state().displayed_frame().cloned().expect("frame");
+    assert_eq!(before.camera.aperture_radius, 0.0, "the default scene starts as a pinhole");
+
+    // Drag the slider from its left end to 60 % of its width.
+    let rect = harness.get_by_role_and_label(Role::Slider, "Aperture radius").rect();
+    let from = rect.left_center() + Vec2::new(2.0, 0.0);
+    let to = rect.lerp_inside(Vec2::new(0.6, 0.5));
+    harness.event(Event::PointerMoved(from));
+    press(&harness, from, true);
+    harness.step();
+    for t in [0.25, 0.5, 0.75, 1.0] {
+        harness.event(Event::PointerMoved(from + (to - from) * t));
+        harness.step();
+    }
+    press(&harness, to, false);
+    harness.step();
+
+    let aperture = harness.state().camera().expect("camera").aperture_radius;
+    assert!(aperture > 0.0, "the drag moved the slider");
+    // The render thread's own camera is the new one…
+    step_until(&mut harness, "the render thread's camera", |app| {
+        app.render_stats().camera.is_some_and(|c| c.aperture_radius == aperture)
+    });
+    // …and the frames it publishes with it belong to a restarted accumulation.
+    step_until(&mut harness, "a frame with the new aperture", |app| {
+        app.displayed_frame()
+            .is_some_and(|f| f.camera.aperture_radius == aperture && !f.preview && f.settings.width == 64)
+    });
+    let after = harness.state().displayed_frame().cloned().expect("frame");
+    assert!(
+        after.generation > before.generation,
+        "generation {} → {}",
+        before.generation,
+        after.generation
+    );
+    // Had the accumulation continued, it would hold the old passes plus at
+    // least one per frame published since; restarted, it holds at most one
+    // per frame published since the restart.
+    assert!(
+        (after.passes as u64) <= after.sequence - before.sequence,
+        "passes {} after {} frames: accumulation was not restarted (before: {} passes)",
+        after.passes,
+        after.sequence - before.sequence,
+        before.passes
+    );
+}
+
+#[test]
+fn clicking_the_image_focuses_on_the_clicked_surface() {
+    let mut harness = start(None);
+    step_until(&mut harness, "the scene", |app| {
+        app.scene().is_some() && app.displayed_frame().is_some()
+    });
+    let initial_focus = harness.state().camera().expect("camera").focal_distance;
+
+    // The glass sphere's centre projects to about (0.64, 0.74) of the image.
+    let rect = harness.get_by_role_and_label(Role::Image, "Rendered image").rect();
+    let click = rect.lerp_inside(Vec2::new(0.64, 0.72));
+    harness.event(Event::PointerMoved(click));
+    press(&harness, click, true);
+    harness.step();
+    press(&harness, click, false);
+    harness.step();
+
+    // Expected: the depth along the view axis of what the scene file's camera sees there.
+    let loaded = scene::load_scene_str(scene::DEFAULT_SCENE, Path::new("cornell"), Path::new(".")).expect("default scene");
+    let film = DVec2::new(
+        ((click.x - rect.min.x) / rect.width()) as f64,
+        ((click.y - rect.min.y) / rect.height()) as f64,
+    );
+    let ray = loaded.camera.generate_ray(film, loaded.settings.aspect(), DVec2::splat(0.5));
+    let hit = loaded
+        .scene
+        .intersect(&ray, f64::INFINITY)
+        .expect("the click hits the sphere");
+    let expected = loaded.camera.depth_of(hit.hit.point);
+
+    let focus = harness.state().camera().expect("camera").focal_distance;
+    // The same ray in the same f64 arithmetic: only float rounding separates them.
+    assert!(
+        (focus - expected).abs() < 1e-9 * expected,
+        "focus {focus} vs expected {expected}"
+    );
+    assert!(
+        (focus - initial_focus).abs() > 1.0,
+        "the click changed the focus ({initial_focus} → {focus})"
+    );
+    assert!(
+        expected < 1000.0,
+        "the sphere (depth {expected}) is in front of the back wall (1355)"
+    );
+    step_until(&mut harness, "the render thread to focus there", |app| {
+        app.render_stats().camera.is_some_and(|c| c.focal_distance == focus)
+    });
+}
+
+#[test]
+fn save_writes_a_valid_image_with_metadata() {
+    let mut harness = start(None);
+    step_until(&mut harness, "a full-resolution frame", |app| {
+        app.displayed_frame().is_some_and(|f| !f.preview && f.passes >= 1)
+    });
+    // Pause so that the frame on screen stays the one that is saved.
+    harness.get_by_label("Pause").click();
+    step_until(&mut harness, "the pause", |app| {
+        app.render_stats().state == SessionState::Paused
+    });
+    harness.step();
+    let path = temporary_path("snapshot.png");
+    let _ = std::fs::remove_file(&path);
+
+    // The path field (the fallback when no file dialog can open), then Save.
+    let field = harness.get_by_role(Role::TextInput);
+    field.focus();
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::A);
+    harness.get_by_role(Role::TextInput).type_text(&path.display().to_string());
+    harness.step();
+    harness.get_by_label("Save").click();
+    harness.step();
+    harness.step();
+
+    assert!(path.exists(), "{} was written", path.display());
+    let saved = prism::output::load_frame(&path).expect("a readable PNG");
+    let shown = harness.state().displayed_frame().cloned().expect("frame");
+    assert_eq!((saved.width, saved.height), (shown.frame.width, shown.frame.height));
+    // Exposure 0 and clamping: the file holds the shown frame up to 8-bit
+    // sRGB quantisation, at most half a code × the decoding slope (≤ 2.3) ≈ 0.0045.
+    let worst = saved
+        .pixels
+        .iter()
+        .zip(&shown.frame.pixels)
+        .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c].clamp(0.0, 1.0)).abs()))
+        .fold(0.0f32, f32::max);
+    assert!(worst < 0.005, "largest pixel difference {worst}");
+
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&path).expect("open")));
+    let reader = decoder.read_info().expect("png header");
+    let text: Vec<(String, String)> = reader
+        .info()
+        .uncompressed_latin1_text
+        .iter()
+        .map(|t| (t.keyword.clone(), t.text.clone()))
+        .collect();
+    let value = |key: &str| text.iter().find(|(k, _)| k == key).map(|(_, v)| v.clone());
+    assert_eq!(value("Scene").as_deref(), Some("<default scene>"));
+    assert_eq!(value("Integrator").as_deref(), Some("pt"));
+    assert_eq!(value("Seed").as_deref(), Some("0"));
+    assert!(
+        value("Samples per pixel").is_some_and(|v| v.parse::<u32>().is_ok_and(|n| n >= 1)),
+        "{text:?}"
+    );
+    assert!(value("Render time").is_some(), "{text:?}");
+    let _ = std::fs::remove_file(&path);
+}
+
+#[test]
+fn broken_scene_shows_its_error_in_the_window() {
+    let path = temporary_path("broken.toml");
+    std::fs::write(
+        &path,
+        "[camera]\nposition = [0, 0, 5]\nlook_at = [0, 0, 0]\nfov_y_degrees = \"wide\"\n",
+    )
+    .expect("write scene");
+    let Err(error) = scene::load_scene_file(&path) else {
+        panic!("the scene should be broken");
+    };
+    let expected = error.to_string();
+    assert!(
+        expected.contains("broken.toml:4"),
+        "the error names file and line: {expected}"
+    );
+
+    let mut harness = start(Some(path.clone()));
+    step_until(&mut harness, "the load to fail", |app| app.scene_error().is_some());
+    harness.step();
+    assert_eq!(harness.state().scene_error(), Some(expected.as_str()));
+    assert!(
+        harness.query_by_label(&expected).is_some(),
+        "the error is shown in the window"
+    );
+    assert!(harness.state().displayed_frame().is_none());
+    let _ = std::fs::remove_file(&path);
+}
