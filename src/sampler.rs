@@ -33,6 +33,8 @@ pub struct Sampler {
     kind: SamplerKind,
     stream_seed: u64,
     sample_index: u32,
+    /// `sample_index` with its bits reversed, computed once per stream.
+    reversed_index: u32,
     dimension: u32,
 }
 
@@ -43,6 +45,7 @@ impl Sampler {
             kind,
             stream_seed: mix64(pixel ^ mix64(seed.wrapping_add(0x9e37_79b9_7f4a_7c15))),
             sample_index,
+            reversed_index: sample_index.reverse_bits(),
             dimension: 0,
         }
     }
@@ -52,8 +55,11 @@ impl Sampler {
         let dimension_seed = self.next_dimension_seed();
         match self.kind {
             SamplerKind::Sobol => {
-                let index = nested_uniform_scramble(self.sample_index, dimension_seed as u32);
-                to_unit(nested_uniform_scramble(index.reverse_bits(), (dimension_seed >> 32) as u32))
+                // The scrambled van der Corput point of the shuffled index:
+                // nested_uniform_scramble(reverse(index)), written so that
+                // reversals cancel (see `shuffled_index`).
+                let index = self.shuffled_index(dimension_seed as u32);
+                to_unit(laine_karras_permutation(index, (dimension_seed >> 32) as u32).reverse_bits())
             }
             SamplerKind::Random => to_unit(mix64(dimension_seed ^ self.sample_index as u64) as u32),
         }
@@ -64,20 +70,26 @@ impl Sampler {
         let dimension_seed = self.next_dimension_seed();
         match self.kind {
             SamplerKind::Sobol => {
-                let index = nested_uniform_scramble(self.sample_index, dimension_seed as u32);
-                let x = index.reverse_bits();
-                let y = sobol_second_dimension(index);
+                let index = self.shuffled_index(dimension_seed as u32);
                 let scramble = mix64(dimension_seed);
-                DVec2::new(
-                    to_unit(nested_uniform_scramble(x, scramble as u32)),
-                    to_unit(nested_uniform_scramble(y, (scramble >> 32) as u32)),
-                )
+                // Sobol' dimensions 0 (reverse(index)) and 1, each Owen-scrambled:
+                // nested_uniform_scramble(v) = reverse(LK(reverse(v))), and
+                // reverse(v) is `index` itself or the bit-reversed dimension 1.
+                let x = laine_karras_permutation(index, scramble as u32).reverse_bits();
+                let y = laine_karras_permutation(sobol_second_dimension_reversed(index), (scramble >> 32) as u32).reverse_bits();
+                DVec2::new(to_unit(x), to_unit(y))
             }
             SamplerKind::Random => {
                 let bits = mix64(dimension_seed ^ self.sample_index as u64);
                 DVec2::new(to_unit(bits as u32), to_unit((bits >> 32) as u32))
             }
         }
+    }
+
+    /// The per-dimension shuffle of the sample index, nested_uniform_scramble(index, seed).
+    #[inline]
+    fn shuffled_index(&self, seed: u32) -> u32 {
+        laine_karras_permutation(self.reversed_index, seed).reverse_bits()
     }
 
     fn next_dimension_seed(&mut self) -> u64 {
@@ -91,8 +103,47 @@ fn to_unit(bits: u32) -> f64 {
     bits as f64 * (1.0 / 4_294_967_296.0)
 }
 
-/// The second Sobol' dimension (primitive polynomial x + 1): direction
-/// numbers v₁ = 2³¹, vⱼ₊₁ = vⱼ ⊕ (vⱼ >> 1), XORed for each set bit of `index`.
+/// The second Sobol' dimension (primitive polynomial x + 1), bit-reversed:
+/// direction numbers v₁ = 2³¹, vⱼ₊₁ = vⱼ ⊕ (vⱼ >> 1) are XORed for each set
+/// bit of `index`. The map is linear over XOR, so it is tabulated per byte.
+fn sobol_second_dimension_reversed(index: u32) -> u32 {
+    let t = &SOBOL_SECOND_DIMENSION_REVERSED;
+    t[0][(index & 0xff) as usize] ^ t[1][((index >> 8) & 0xff) as usize] ^ t[2][((index >> 16) & 0xff) as usize] ^ t[3][(index >> 24) as usize]
+}
+
+const SOBOL_SECOND_DIMENSION_REVERSED: [[u32; 256]; 4] = {
+    let mut directions = [0u32; 32];
+    let mut v = 1u32 << 31;
+    let mut j = 0;
+    while j < 32 {
+        directions[j] = v.reverse_bits();
+        v ^= v >> 1;
+        j += 1;
+    }
+    let mut tables = [[0u32; 256]; 4];
+    let mut byte = 0;
+    while byte < 4 {
+        let mut value = 0;
+        while value < 256 {
+            let mut acc = 0;
+            let mut bit = 0;
+            while bit < 8 {
+                if value & (1 << bit) != 0 {
+                    acc ^= directions[byte * 8 + bit];
+                }
+                bit += 1;
+            }
+            tables[byte][value] = acc;
+            value += 1;
+        }
+        byte += 1;
+    }
+    tables
+};
+
+/// The second Sobol' dimension computed bit by bit (the definition the
+/// tables are checked against).
+#[cfg(test)]
 fn sobol_second_dimension(mut index: u32) -> u32 {
     let mut result = 0;
     let mut direction = 1u32 << 31;
@@ -108,6 +159,7 @@ fn sobol_second_dimension(mut index: u32) -> u32 {
 
 /// Owen scrambling of a 32-bit fixed-point value: a hash-based
 /// Laine–Karras permutation applied to the bit-reversed value (Burley 2020).
+#[cfg(test)]
 fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
     laine_karras_permutation(x.reverse_bits(), seed).reverse_bits()
 }
@@ -143,7 +195,7 @@ mod tests {
                 .collect();
             for log_x in 0..=4 {
                 let (nx, ny) = (1usize << log_x, 1usize << (4 - log_x));
-                let mut cells = vec![0; 16];
+                let mut cells = [0; 16];
                 for p in &points {
                     let cx = (p.x * nx as f64) as usize;
                     let cy = (p.y * ny as f64) as usize;
@@ -151,6 +203,25 @@ mod tests {
                 }
                 assert!(cells.iter().all(|&c| c == 1), "pixel {pixel}, grid {nx}x{ny}");
             }
+        }
+    }
+
+    /// The fast paths compute exactly Burley's formulation.
+    #[test]
+    fn fast_sobol_equals_the_definition() {
+        for index in [0u32, 1, 2, 3, 77, 1 << 20, u32::MAX, 0x1234_5678] {
+            assert_eq!(sobol_second_dimension_reversed(index), sobol_second_dimension(index).reverse_bits());
+        }
+        let (pixel, sample, seed) = (12u64, 37u32, 5u64);
+        let mut fast = Sampler::new(SamplerKind::Sobol, pixel, sample, seed);
+        let mut reference = Sampler::new(SamplerKind::Sobol, pixel, sample, seed);
+        for _ in 0..4 {
+            let dimension_seed = reference.next_dimension_seed();
+            let index = nested_uniform_scramble(sample, dimension_seed as u32);
+            let scramble = mix64(dimension_seed);
+            let x = nested_uniform_scramble(index.reverse_bits(), scramble as u32);
+            let y = nested_uniform_scramble(sobol_second_dimension(index), (scramble >> 32) as u32);
+            assert_eq!(fast.next_2d(), DVec2::new(to_unit(x), to_unit(y)));
         }
     }
 

@@ -4,7 +4,7 @@
 use super::sah::{self, BuildItem, BuildNode};
 use crate::math::{Aabb, Ray};
 
-/// 56 bytes: bounds, then either the first primitive (leaf) or the second child.
+/// 64 bytes: bounds, then either the first primitive (leaf) or the second child.
 #[derive(Clone, Copy, Debug)]
 struct Node {
     bounds: Aabb,
@@ -12,6 +12,8 @@ struct Node {
     offset: u32,
     /// Number of primitives; zero for interior nodes.
     count: u16,
+    /// Split axis of an interior node, to visit the nearer child first.
+    axis: u8,
 }
 
 #[derive(Clone, Debug, Default)]
@@ -76,64 +78,45 @@ impl Bvh {
         found
     }
 
-    /// Front-to-back traversal; `visit` returns true to stop early. Both
-    /// children's boxes are tested at each interior node; the nearer is
-    /// entered first and the farther pushed only if it is hit at all.
+    /// Front-to-back traversal; `visit` returns true to stop early.
     #[inline]
     fn traverse(&self, ray: &Ray, t_max: &mut f64, mut visit: impl FnMut(usize, &mut f64) -> bool) {
-        let Some(root) = self.nodes.first() else { return };
-        let inverse_direction = glam::DVec3::ONE / ray.direction;
-        if root.bounds.hit_distance(ray.origin, inverse_direction, *t_max).is_none() {
+        if self.nodes.is_empty() {
             return;
         }
-        // Pending subtrees with the distance at which the ray enters them.
-        let mut stack = [(0u32, 0.0f64); 64];
+        let inverse_direction = glam::DVec3::ONE / ray.direction;
+        let negative = [inverse_direction.x < 0.0, inverse_direction.y < 0.0, inverse_direction.z < 0.0];
+        let mut stack = [0u32; 64];
         let mut stack_len = 0;
         let mut current = 0usize;
         loop {
             let node = &self.nodes[current];
-            if node.count > 0 {
-                let first = node.offset as usize;
-                for index in first..first + node.count as usize {
-                    if visit(index, t_max) {
-                        return;
+            if node.bounds.hit_distance(ray.origin, inverse_direction, *t_max).is_some() {
+                if node.count > 0 {
+                    let first = node.offset as usize;
+                    for index in first..first + node.count as usize {
+                        if visit(index, t_max) {
+                            return;
+                        }
                     }
-                }
-            } else {
-                let (left, right) = (current + 1, node.offset as usize);
-                let hit_left = self.nodes[left].bounds.hit_distance(ray.origin, inverse_direction, *t_max);
-                let hit_right = self.nodes[right].bounds.hit_distance(ray.origin, inverse_direction, *t_max);
-                match (hit_left, hit_right) {
-                    (Some(a), Some(b)) => {
-                        let (near, far, far_t) = if a <= b { (left, right, b) } else { (right, left, a) };
-                        stack[stack_len] = (far as u32, far_t);
-                        stack_len += 1;
-                        current = near;
-                        continue;
-                    }
-                    (Some(_), None) => {
-                        current = left;
-                        continue;
-                    }
-                    (None, Some(_)) => {
-                        current = right;
-                        continue;
-                    }
-                    (None, None) => {}
+                } else {
+                    // Visit the child on the ray's near side first.
+                    let (near, far) = if negative[node.axis as usize] {
+                        (node.offset as usize, current + 1)
+                    } else {
+                        (current + 1, node.offset as usize)
+                    };
+                    stack[stack_len] = far as u32;
+                    stack_len += 1;
+                    current = near;
+                    continue;
                 }
             }
-            // Pop the next subtree that may still hold a nearer hit.
-            loop {
-                if stack_len == 0 {
-                    return;
-                }
-                stack_len -= 1;
-                let (node, entry) = stack[stack_len];
-                if entry <= *t_max {
-                    current = node as usize;
-                    break;
-                }
+            if stack_len == 0 {
+                return;
             }
+            stack_len -= 1;
+            current = stack[stack_len] as usize;
         }
     }
 }
@@ -144,13 +127,15 @@ fn flatten(node: &BuildNode, nodes: &mut Vec<Node>) {
             bounds: *bounds,
             offset: *first as u32,
             count: *count as u16,
+            axis: 0,
         }),
-        BuildNode::Interior { bounds, children, .. } => {
+        BuildNode::Interior { bounds, axis, children, .. } => {
             let index = nodes.len();
             nodes.push(Node {
                 bounds: *bounds,
                 offset: 0,
                 count: 0,
+                axis: *axis as u8,
             });
             flatten(&children[0], nodes);
             nodes[index].offset = nodes.len() as u32;

@@ -26,6 +26,7 @@ pub enum BuildNode {
     },
     Interior {
         bounds: Aabb,
+        axis: usize,
         children: Box<[BuildNode; 2]>,
         node_count: usize,
     },
@@ -120,6 +121,7 @@ pub fn build(items: &mut [BuildItem], first: usize) -> BuildNode {
     let node_count = 1 + left.node_count() + right.node_count();
     BuildNode::Interior {
         bounds,
+        axis,
         children: Box::new([left, right]),
         node_count,
     }

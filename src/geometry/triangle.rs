@@ -52,11 +52,11 @@ impl Triangle {
         let shear_y = -dir.y / dir.z;
         let shear_z = 1.0 / dir.z;
         // Translate vertices to the ray origin, then shear so the ray is +z.
-        let mut p = self.vertices.map(|v| permute(v - ray.origin));
-        for v in &mut p {
-            v.x += shear_x * v.z;
-            v.y += shear_y * v.z;
-        }
+        let transform = |v: DVec3| {
+            let v = permute(v - ray.origin);
+            DVec3::new(v.x + shear_x * v.z, v.y + shear_y * v.z, v.z)
+        };
+        let p = [transform(self.vertices[0]), transform(self.vertices[1]), transform(self.vertices[2])];
         // Edge functions; exact sign at zero falls back to a tie-break in the
         // same way for both triangles sharing the edge.
         let e0 = p[1].x * p[2].y - p[1].y * p[2].x;
@@ -69,7 +69,7 @@ impl Triangle {
         if det == 0.0 {
             return None;
         }
-        let z = p.map(|v| v.z * shear_z);
+        let z = [p[0].z * shear_z, p[1].z * shear_z, p[2].z * shear_z];
         let t_scaled = e0 * z[0] + e1 * z[1] + e2 * z[2];
         if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
             return None;
@@ -81,10 +81,10 @@ impl Triangle {
         let t = t_scaled * inverse_det;
         // Conservative lower bound on t (pbrt-v4 6.5.3) so hits at the origin
         // produced by rounding are rejected.
-        let max_z = z.map(f64::abs).into_iter().fold(0.0, f64::max);
+        let max_z = z[0].abs().max(z[1].abs()).max(z[2].abs());
         let delta_z = gamma(3) * max_z;
-        let max_x = p.map(|v| v.x.abs()).into_iter().fold(0.0, f64::max);
-        let max_y = p.map(|v| v.y.abs()).into_iter().fold(0.0, f64::max);
+        let max_x = p[0].x.abs().max(p[1].x.abs()).max(p[2].x.abs());
+        let max_y = p[0].y.abs().max(p[1].y.abs()).max(p[2].y.abs());
         let delta_x = gamma(5) * (max_x + max_z);
         let delta_y = gamma(5) * (max_y + max_z);
         let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);

@@ -88,16 +88,29 @@ impl Aabb {
     /// Slab test against `[0, t_max]`. `inverse_direction` is `1 / direction`
     /// per component. The far distance is enlarged by `1 + 2γ(3)` so a ray
     /// that grazes a box edge is never culled by rounding (pbrt-v4 6.1.2).
+    /// Plain comparisons rather than `f64::min`/`max`: they compile to one
+    /// instruction each, and a NaN (0 · ∞ when the origin lies on a slab)
+    /// fails them and leaves the interval unchanged, as it should.
     #[inline]
     pub fn hit_distance(&self, origin: DVec3, inverse_direction: DVec3, t_max: f64) -> Option<f64> {
-        let t0 = (self.min - origin) * inverse_direction;
-        let t1 = (self.max - origin) * inverse_direction;
-        let near = t0.min(t1);
-        let far = t0.max(t1) * (1.0 + 2.0 * gamma(3));
-        // NaN (0 * inf when the origin lies on a slab) is dropped by max/min.
-        let enter = near.x.max(near.y).max(near.z).max(0.0);
-        let exit = far.x.min(far.y).min(far.z).min(t_max);
-        (enter <= exit).then_some(enter)
+        let mut enter = 0.0;
+        let mut exit = t_max;
+        for axis in 0..3 {
+            let a = (self.min[axis] - origin[axis]) * inverse_direction[axis];
+            let b = (self.max[axis] - origin[axis]) * inverse_direction[axis];
+            let (near, far) = if a > b { (b, a) } else { (a, b) };
+            let far = far * (1.0 + 2.0 * gamma(3));
+            if near > enter {
+                enter = near;
+            }
+            if far < exit {
+                exit = far;
+            }
+            if enter > exit {
+                return None;
+            }
+        }
+        Some(enter)
     }
 }
 
