@@ -64,14 +64,7 @@ pub fn save_frame(frame: &Frame, path: &Path, exposure_stops: f64, tone_map: Ton
 fn write_to(frame: &Frame, path: &Path, format: ImageFormat, exposure_stops: f64, tone_map: ToneMap, metadata: &[(String, String)]) -> Result<(), String> {
     let (width, height) = (frame.width, frame.height);
     match format {
-        ImageFormat::Exr => {
-            let scale = exposure_stops.exp2() as f32;
-            let data: Vec<f32> = frame.pixels.iter().flat_map(|p| p.map(|c| c * scale)).collect();
-            let buffer = image::Rgb32FImage::from_raw(width, height, data).ok_or("frame size mismatch")?;
-            image::DynamicImage::ImageRgb32F(buffer)
-                .save_with_format(path, image::ImageFormat::OpenExr)
-                .map_err(|e| e.to_string())
-        }
+        ImageFormat::Exr => write_exr(frame, path, exposure_stops, metadata),
         ImageFormat::Png => {
             let data: Vec<u8> = frame.to_srgb8(exposure_stops, tone_map).into_iter().flatten().collect();
             let file = File::create(path).map_err(|e| e.to_string())?;
@@ -97,6 +90,30 @@ fn write_to(frame: &Frame, path: &Path, format: ImageFormat, exposure_stops: f64
             writer.flush().map_err(|e| e.to_string())
         }
     }
+}
+
+/// Linear 32-bit float RGB through the `exr` crate directly (image's encoder
+/// cannot attach attributes); `metadata` becomes string attributes.
+fn write_exr(frame: &Frame, path: &Path, exposure_stops: f64, metadata: &[(String, String)]) -> Result<(), String> {
+    use exr::prelude::*;
+    if frame.pixels.len() != frame.width as usize * frame.height as usize {
+        return Err("frame size mismatch".into());
+    }
+    let scale = exposure_stops.exp2() as f32;
+    let width = frame.width as usize;
+    let channels = SpecificChannels::rgb(|position: Vec2<usize>| {
+        let p = frame.pixels[position.y() * width + position.x()];
+        (p[0] * scale, p[1] * scale, p[2] * scale)
+    });
+    let mut attributes = LayerAttributes::default();
+    for (key, value) in metadata {
+        // EXR text is Latin-1 without NUL; anything else is left out.
+        if let (Some(key), Some(value)) = (Text::new_or_none(key), Text::new_or_none(value)) {
+            attributes.other.insert(key, AttributeValue::Text(value));
+        }
+    }
+    let layer = Layer::new((width, frame.height as usize), attributes, Encoding::FAST_LOSSLESS, channels);
+    Image::from_layer(layer).write().to_file(path).map_err(|e| e.to_string())
 }
 
 /// Reads an image file back as a linear frame (EXR stays linear; 8-bit
