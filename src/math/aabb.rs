@@ -88,14 +88,22 @@ impl Aabb {
     /// Slab test against `[0, t_max]`. `inverse_direction` is `1 / direction`
     /// per component. The far distance is enlarged by `1 + 2γ(3)` so a ray
     /// that grazes a box edge is never culled by rounding (pbrt-v4 6.1.2).
-    /// Plain comparisons rather than `f64::min`/`max`: they compile to one
-    /// instruction each, and a NaN (0 · ∞ when the origin lies on a slab)
-    /// fails them and leaves the interval unchanged, as it should.
+    /// A direction component of ±0 (infinite inverse) means the ray runs
+    /// parallel to that slab: it is inside for all t or for none, decided by
+    /// the origin alone (multiplying would give 0 · ∞ = NaN for a ray in the
+    /// slab's plane). Plain comparisons rather than `f64::min`/`max`: one
+    /// instruction each.
     #[inline]
     pub fn hit_distance(&self, origin: DVec3, inverse_direction: DVec3, t_max: f64) -> Option<f64> {
         let mut enter = 0.0;
         let mut exit = t_max;
         for axis in 0..3 {
+            if inverse_direction[axis].is_infinite() {
+                if origin[axis] < self.min[axis] || origin[axis] > self.max[axis] {
+                    return None;
+                }
+                continue;
+            }
             let a = (self.min[axis] - origin[axis]) * inverse_direction[axis];
             let b = (self.max[axis] - origin[axis]) * inverse_direction[axis];
             let (near, far) = if a > b { (b, a) } else { (a, b) };
@@ -128,9 +136,14 @@ mod tests {
         assert_eq!(miss, None);
         let inside = b.hit_distance(DVec3::ZERO, inv(DVec3::new(1.0, 1.0, 0.0).normalize()), 10.0);
         assert_eq!(inside, Some(0.0));
-        // Grazing along a face plane still counts as touching the box.
+        // Grazing along a face plane still counts as touching the box, also
+        // with a negative-zero direction component (1 / -0 = -∞, 0 · ∞ = NaN).
         let grazing = b.hit_distance(DVec3::new(-3.0, 1.0, 0.0), inv(DVec3::X), 10.0);
         assert!(grazing.is_some());
+        let negative_zero = b.hit_distance(DVec3::new(-3.0, 1.0, 0.0), inv(DVec3::new(1.0, -0.0, 0.0)), 10.0);
+        assert_eq!(negative_zero, Some(2.0));
+        let outside = b.hit_distance(DVec3::new(-3.0, 1.0 + 1e-12, 0.0), inv(DVec3::new(1.0, -0.0, 0.0)), 10.0);
+        assert_eq!(outside, None);
     }
 
     #[test]
