@@ -102,3 +102,49 @@ fn light_sampling_reduces_variance() {
     let (_, bsdf_error) = mean_and_error(&loaded, &Job { integrator: IntegratorKind::BsdfOnly, ..job }, 6);
     assert!(nee_error[1] < bsdf_error[1], "NEE {nee_error:?} vs BSDF {bsdf_error:?}");
 }
+
+/// An emissive surface of revolution as the only light: light sampling uses
+/// its area and area sampling, BSDF sampling only its intersection, so the two
+/// estimators agree only if the area, the sampling density and the hits are
+/// all right. Same three-standard-error criterion as the Cornell test.
+#[test]
+fn emissive_revolution_light_sampling_agrees_with_bsdf_sampling() {
+    let loaded = scene(
+        r#"
+[camera]
+position = [0, 4, 12]
+look_at = [0, 1, 0]
+fov_y_degrees = 45
+
+[materials.floor]
+type = "diffuse"
+albedo = [0.7, 0.7, 0.7]
+
+[materials.lamp]
+type = "emissive"
+radiance = [4, 3, 2]
+two_sided = true
+
+[[objects]]
+type = "quad"
+corner = [-10, 0, -10]
+edge_u = [0, 0, 20]
+edge_v = [20, 0, 0]
+material = "floor"
+
+[[objects]]
+type = "revolution"
+profile = [[0.0, 0.5], [3.0, 1.0], [0.2, 2.5], [1.0, 3.5]]
+material = "lamp"
+"#,
+    );
+    let job = Job { width: 24, height: 16, spp: 32, max_depth: 8, ..Job::default() };
+    let (nee, nee_error) = mean_and_error(&loaded, &Job { integrator: IntegratorKind::PathTracing, ..job }, 8);
+    let (bsdf, bsdf_error) = mean_and_error(&loaded, &Job { integrator: IntegratorKind::BsdfOnly, ..job }, 8);
+    eprintln!("revolution light: NEE {nee:?} ± {nee_error:?}, BSDF {bsdf:?} ± {bsdf_error:?}");
+    for c in 0..3 {
+        let combined = (nee_error[c].powi(2) + bsdf_error[c].powi(2)).sqrt();
+        assert!((nee[c] - bsdf[c]).abs() < 3.0 * combined, "channel {c}: NEE {} ± {}, BSDF {} ± {}", nee[c], nee_error[c], bsdf[c], bsdf_error[c]);
+        assert!(nee[c] > 0.05 && combined < 0.05 * nee[c], "channel {c}: {nee:?} ± {combined}");
+    }
+}
