@@ -17,12 +17,20 @@ fn bunny() -> (Vec<Primitive>, Mesh) {
         Ok(m) => m,
         Err(e) => panic!("{}: {e}", path.display()),
     };
-    let primitives = mesh.triangles(0).map(|t| Primitive { shape: Shape::Triangle(t), material: 0 }).collect();
+    let primitives = mesh
+        .triangles(0)
+        .map(|t| Primitive {
+            shape: Shape::Triangle(t),
+            material: 0,
+        })
+        .collect();
     (primitives, mesh)
 }
 
 fn material() -> Vec<Material> {
-    vec![Material::Diffuse { albedo: Texture::Constant(DVec3::ONE) }]
+    vec![Material::Diffuse {
+        albedo: Texture::Constant(DVec3::ONE),
+    }]
 }
 
 /// Rays from random points on a sphere around the bunny towards random points
@@ -53,7 +61,9 @@ fn benchmarks(c: &mut Criterion) {
 
     let mut group = c.benchmark_group("bvh_build_bunny");
     group.throughput(Throughput::Elements(bounds.len() as u64));
-    group.bench_function("binned_sah", |b| b.iter(|| black_box(prism::accel::Bvh::build(black_box(&bounds)))));
+    group.bench_function("binned_sah", |b| {
+        b.iter(|| black_box(prism::accel::Bvh::build(black_box(&bounds))))
+    });
     group.finish();
 
     let scene = Scene::new(primitives, vec![mesh], material(), DVec3::ZERO);
@@ -69,10 +79,22 @@ fn benchmarks(c: &mut Criterion) {
             Err(e) => panic!("{e}"),
         };
         group.bench_function(format!("closest_hit_{threads}_threads"), |b| {
-            b.iter(|| pool.install(|| rays.par_chunks(1024).map(|chunk| chunk.iter().filter(|r| scene.intersect(r, f64::INFINITY).is_some()).count()).sum::<usize>()))
+            b.iter(|| {
+                pool.install(|| {
+                    rays.par_chunks(1024)
+                        .map(|chunk| chunk.iter().filter(|r| scene.intersect(r, f64::INFINITY).is_some()).count())
+                        .sum::<usize>()
+                })
+            })
         });
         group.bench_function(format!("shadow_ray_{threads}_threads"), |b| {
-            b.iter(|| pool.install(|| rays.par_chunks(1024).map(|chunk| chunk.iter().filter(|r| scene.occluded(r, f64::INFINITY)).count()).sum::<usize>()))
+            b.iter(|| {
+                pool.install(|| {
+                    rays.par_chunks(1024)
+                        .map(|chunk| chunk.iter().filter(|r| scene.occluded(r, f64::INFINITY)).count())
+                        .sum::<usize>()
+                })
+            })
         });
     }
     group.finish();

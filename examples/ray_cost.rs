@@ -19,8 +19,21 @@ fn main() {
             std::process::exit(1);
         }
     };
-    let primitives = mesh.triangles(0).map(|t| Primitive { shape: Shape::Triangle(t), material: 0 }).collect();
-    let scene = Scene::new(primitives, vec![mesh], vec![Material::Diffuse { albedo: Texture::Constant(DVec3::ONE) }], DVec3::ZERO);
+    let primitives = mesh
+        .triangles(0)
+        .map(|t| Primitive {
+            shape: Shape::Triangle(t),
+            material: 0,
+        })
+        .collect();
+    let scene = Scene::new(
+        primitives,
+        vec![mesh],
+        vec![Material::Diffuse {
+            albedo: Texture::Constant(DVec3::ONE),
+        }],
+        DVec3::ZERO,
+    );
     let bounds = scene.bounds();
     let mut state = 0x9e37_79b9_7f4a_7c15u64;
     let mut next = move || {

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {
-    /// Scene files (default: every scenes/*.toml).
+    /// Scene files (default: every scenes/*.toml; those without a reference are skipped).
     scenes: Vec<PathBuf>,
     /// Directory of the small reference images (<scene stem>.exr).
     #[arg(long, default_value = "references")]
@@ -28,9 +28,9 @@ pub struct BenchArgs {
     /// Worker threads for every render.
     #[arg(long, default_value_t = 2)]
     threads: usize,
-    /// Noise threshold of the adaptive-sampling configuration.
-    #[arg(long, default_value_t = 0.05)]
-    adaptive_threshold: f64,
+    /// Noise thresholds of the adaptive-sampling configurations (comma-separated).
+    #[arg(long, value_delimiter = ',', default_values_t = [0.05])]
+    adaptive_threshold: Vec<f64>,
     /// Only these configurations (comma-separated names as in the CSV, e.g. pt/sobol,pt-bsdf/sobol).
     #[arg(long, value_delimiter = ',')]
     configurations: Vec<String>,
@@ -104,9 +104,18 @@ fn references_command(args: &BenchArgs, seconds: f64) -> Result<()> {
         let loaded = scene::load_scene_file(&file)?;
         let settings = error_curves::reference_settings(&loaded.settings, args.reference_width, seconds);
         let path = error_curves::reference_path(&args.references, &file);
-        eprintln!("{}: rendering {}x{} for {seconds} s ...", file.display(), settings.width, settings.height);
+        eprintln!(
+            "{}: rendering {}x{} for {seconds} s ...",
+            file.display(),
+            settings.width,
+            settings.height
+        );
         let passes = error_curves::make_reference(&loaded, &settings, &path)?;
-        eprintln!("wrote {} ({passes} samples per pixel, seed {})", path.display(), settings.seed);
+        eprintln!(
+            "wrote {} ({passes} samples per pixel, seed {})",
+            path.display(),
+            settings.seed
+        );
     }
     Ok(())
 }
@@ -116,29 +125,59 @@ fn curves_command(args: &BenchArgs) -> Result<()> {
         bail!("need 0 < --min-seconds <= --max-seconds");
     }
     let ladder = error_curves::time_ladder(args.min_seconds, args.max_seconds);
-    let mut configurations = error_curves::Configuration::standard(args.adaptive_threshold);
+    if args.adaptive_threshold.iter().any(|t| !(t.is_finite() && *t > 0.0)) {
+        bail!("--adaptive-threshold values must be positive numbers");
+    }
+    let mut configurations = error_curves::Configuration::standard(&args.adaptive_threshold);
     if !args.configurations.is_empty() {
         configurations.retain(|c| args.configurations.contains(&c.name));
         if configurations.is_empty() {
-            bail!("no configuration matches; names are {:?}", error_curves::Configuration::standard(args.adaptive_threshold).iter().map(|c| c.name.clone()).collect::<Vec<_>>());
+            bail!(
+                "no configuration matches; names are {:?}",
+                error_curves::Configuration::standard(&args.adaptive_threshold)
+                    .iter()
+                    .map(|c| c.name.clone())
+                    .collect::<Vec<_>>()
+            );
         }
     }
     for file in scene_files(args)? {
         let name = stem(&file);
         let loaded: LoadedScene = scene::load_scene_file(&file)?;
         let reference_file = error_curves::reference_path(&args.references, &file);
-        let reference = load_frame(&reference_file).map_err(|e| {
-            anyhow::anyhow!("{e}\n(make it with: prism bench {} --make-references 600)", file.display())
-        })?;
-        eprintln!("{name}: {} configurations, ladder {ladder:?} s, {}x{}", configurations.len(), reference.width, reference.height);
+        if args.scenes.is_empty() && !reference_file.exists() {
+            eprintln!(
+                "{name}: skipped, no reference {} (make it with --make-references)",
+                reference_file.display()
+            );
+            continue;
+        }
+        let reference = load_frame(&reference_file)
+            .map_err(|e| anyhow::anyhow!("{e}\n(make it with: prism bench {} --make-references 600)", file.display()))?;
+        eprintln!(
+            "{name}: {} configurations, ladder {ladder:?} s, {}x{}",
+            configurations.len(),
+            reference.width,
+            reference.height
+        );
         let machine_before = bench::machine_note();
-        let curves = error_curves::measure_scene(&name, &loaded, &reference, &configurations, &ladder, |configuration, outcome| match outcome {
-            error_curves::CurveOutcome::Skipped(reason) => eprintln!("  {}: skipped: {reason}", configuration.name),
-            error_curves::CurveOutcome::Measured(points) => {
-                let line: Vec<String> = points.iter().map(|p| format!("{:.1}s:{:.4}", p.elapsed_seconds, p.metrics.rmse)).collect();
-                eprintln!("  {:<24} RMSE {}", configuration.name, line.join(" "));
-            }
-        })?;
+        let curves = error_curves::measure_scene(
+            &name,
+            &loaded,
+            &reference,
+            &configurations,
+            &ladder,
+            |configuration, outcome| match outcome {
+                error_curves::CurveOutcome::Skipped(reason) => eprintln!("  {}: skipped: {reason}", configuration.name),
+                error_curves::CurveOutcome::Measured(points) => {
+                    let line: Vec<String> = points
+                        .iter()
+                        .map(|p| format!("{:.1}s:{:.4}", p.elapsed_seconds, p.metrics.rmse))
+                        .collect();
+                    eprintln!("  {:<24} RMSE {}", configuration.name, line.join(" "));
+                }
+            },
+        )?;
         let machine = format!("before: {machine_before}; after: {}", bench::machine_note());
         let csv_path = args.output_dir.join(format!("error_{name}.csv"));
         let png_path = args.output_dir.join(format!("error_{name}.png"));
@@ -157,9 +196,17 @@ fn scaling_command(args: &BenchArgs) -> Result<()> {
         n = n.saturating_mul(4);
     }
     eprintln!("BVH: {counts:?} triangles");
-    let bvh_rows = scaling::measure_bvh(&counts, 200_000, |r| {
-        eprintln!("  {:>8} triangles: build {:.4} s, {:.0} ns/ray, {:.0}% hit", r.triangles, r.build_seconds, r.ns_per_ray, 100.0 * r.hit_fraction)
-    });
+    let bvh_rows = scaling::measure_bvh(&counts, 500_000, |r| {
+        eprintln!(
+            "  {:>8} triangles: build {:.4} s CPU ({:.4} s wall), {:.0} ns/ray CPU ({:.0} wall), {:.0}% hit",
+            r.triangles,
+            r.build_seconds,
+            r.build_wall_seconds,
+            r.ns_per_ray,
+            r.wall_ns_per_ray,
+            100.0 * r.hit_fraction
+        )
+    })?;
     scaling::write_bvh_results(&bvh_rows, &bench::machine_note(), &args.output_dir)?;
 
     let file = scene_files(args)?.into_iter().next();
@@ -170,11 +217,25 @@ fn scaling_command(args: &BenchArgs) -> Result<()> {
     let name = file.as_deref().map_or("cornell".into(), stem);
     let threads: Vec<usize> = (1..=args.threads.min(2)).collect();
     eprintln!("render: {name}, threads {threads:?}");
-    let render_rows = scaling::measure_render(&loaded.scene, &loaded.camera, &loaded.settings, &[64, 128, 256, 512], &threads, 4, |r| {
-        eprintln!("  {}x{} {} thread(s): {:.3} s, {:.0} ns/sample", r.width, r.height, r.threads, r.seconds, r.ns_per_sample)
-    })?;
+    let render_rows = scaling::measure_render(
+        &loaded.scene,
+        &loaded.camera,
+        &loaded.settings,
+        &[64, 128, 256, 512],
+        &threads,
+        4,
+        |r| {
+            eprintln!(
+                "  {}x{} {} thread(s): {:.3} s, {:.0} ns/sample",
+                r.width, r.height, r.threads, r.seconds, r.ns_per_sample
+            )
+        },
+    )?;
     scaling::write_render_results(&render_rows, &name, &bench::machine_note(), &args.output_dir)?;
-    eprintln!("wrote bvh_scaling.csv, bvh_build.png, ray_cost.png, render_scaling.csv, render_scaling.png in {}", args.output_dir.display());
+    eprintln!(
+        "wrote bvh_scaling.csv, bvh_build.png, ray_cost.png, render_scaling.csv, render_scaling.png in {}",
+        args.output_dir.display()
+    );
     Ok(())
 }
 
@@ -188,7 +249,12 @@ fn stress_command(args: &BenchArgs) -> Result<()> {
         closed_mesh: bunny.exists().then_some(bunny),
         photons_per_iteration: 100_000,
     };
-    let rows = stress::run(&options, |r| eprintln!("  {:<32} {:<26} {:>10} tested, {} failures", r.scene, r.check, r.tested, r.failures))?;
+    let rows = stress::run(&options, |r| {
+        eprintln!(
+            "  {:<32} {:<26} {:>10} tested, {} failures",
+            r.scene, r.check, r.tested, r.failures
+        )
+    })?;
     let path = args.output_dir.join("stress.csv");
     stress::write_results(&rows, &options, &bench::machine_note(), &path)?;
     let failures: u64 = rows.iter().map(|r| r.failures).sum();

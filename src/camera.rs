@@ -120,7 +120,8 @@ mod tests {
         let film = DVec2::new(0.2, 0.7);
         let meet = |lens: DVec2| {
             let r = camera.generate_ray(film, 1.5, lens);
-            let t = (camera.depth_of(camera.position + camera.forward() * 7.0) - camera.depth_of(r.origin)) / r.direction.dot(camera.forward());
+            let t = (camera.depth_of(camera.position + camera.forward() * 7.0) - camera.depth_of(r.origin))
+                / r.direction.dot(camera.forward());
             r.at(t)
         };
         let a = meet(DVec2::new(0.1, 0.9));

@@ -23,7 +23,11 @@ impl PixelAccumulator {
     }
 
     pub fn mean(&self) -> Color {
-        if self.count == 0 { Color::ZERO } else { self.sum / self.count as f64 }
+        if self.count == 0 {
+            Color::ZERO
+        } else {
+            self.sum / self.count as f64
+        }
     }
 
     /// Standard error of the pixel's mean luminance (unbiased sample variance / n).

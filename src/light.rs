@@ -104,7 +104,9 @@ impl Lights {
         let light = &self.lights[index as usize];
         let shape = shapes[light.primitive as usize].shape();
         let (point, point_error, normal, pdf) = match shape {
-            Shape::Sphere(sphere) if (reference - sphere.center).length_squared() > sphere.radius * sphere.radius * (1.0 + 1e-9) => {
+            Shape::Sphere(sphere)
+                if (reference - sphere.center).length_squared() > sphere.radius * sphere.radius * (1.0 + 1e-9) =>
+            {
                 sample_sphere_cone(sphere.center, sphere.radius, reference, u)?
             }
             _ => {
@@ -143,7 +145,9 @@ impl Lights {
         let shape = shapes[light.primitive as usize].shape();
         let selection = self.probability[index as usize];
         match shape {
-            Shape::Sphere(sphere) if (reference - sphere.center).length_squared() > sphere.radius * sphere.radius * (1.0 + 1e-9) => {
+            Shape::Sphere(sphere)
+                if (reference - sphere.center).length_squared() > sphere.radius * sphere.radius * (1.0 + 1e-9) =>
+            {
                 let sin2_max = sphere.radius * sphere.radius / (reference - sphere.center).length_squared();
                 let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
                 warp::uniform_cone_pdf(cos_max) * selection

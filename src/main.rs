@@ -47,15 +47,19 @@ struct RenderArgs {
     /// Render for this many seconds instead of a sample count.
     #[arg(long)]
     time: Option<f64>,
+    /// Image width in pixels (default: the scene's).
     #[arg(long)]
     width: Option<u32>,
+    /// Image height in pixels (default: the scene's).
     #[arg(long)]
     height: Option<u32>,
     /// Worker threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
+    /// The same scene, seed and sample count give the same image on any thread count.
     #[arg(long)]
     seed: Option<u64>,
+    /// sobol (Owen-scrambled Sobol', default) or random (independent).
     #[arg(long, value_parser = parse_sampler)]
     sampler: Option<SamplerKind>,
     /// pt (NEE + MIS), pt-bsdf (BSDF sampling only) or sppm.
@@ -204,7 +208,10 @@ fn apply_overrides(settings: &mut RenderSettings, args: &RenderArgs) -> Result<(
 
 fn render_command(args: RenderArgs) -> Result<()> {
     if prism::output::ImageFormat::from_path(&args.output).is_none() {
-        bail!("{}: unsupported image format (use .png, .bmp, .ppm or .exr)", args.output.display());
+        bail!(
+            "{}: unsupported image format (use .png, .bmp, .ppm or .exr)",
+            args.output.display()
+        );
     }
     let loaded = load(args.scene.as_deref())?;
     let mut settings = loaded.settings.clone();
@@ -217,6 +224,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
     let bar = progress_bar(&settings, args.quiet);
     let pixels = settings.pixel_count() as f64;
     let cancel = AtomicBool::new(false);
+    let started = std::time::Instant::now();
     let integrator = pool.install(|| {
         render::render_progressive(&loaded.scene, &loaded.camera, &settings, &cancel, |integrator, progress| {
             let rate = pixels * progress.passes as f64 / progress.elapsed.as_secs_f64().max(1e-9);
@@ -233,18 +241,34 @@ fn render_command(args: RenderArgs) -> Result<()> {
     let frame = integrator.frame();
     let metadata = vec![
         ("Software".to_string(), format!("prism {}", env!("CARGO_PKG_VERSION"))),
-        ("Scene".to_string(), args.scene.as_ref().map_or("<default scene>".into(), |p| p.display().to_string())),
+        (
+            "Scene".to_string(),
+            args.scene
+                .as_ref()
+                .map_or("<default scene>".into(), |p| p.display().to_string()),
+        ),
         ("Integrator".to_string(), settings.integrator.to_string()),
         ("Passes".to_string(), integrator.passes().to_string()),
         ("Seed".to_string(), settings.seed.to_string()),
+        ("RenderSeconds".to_string(), format!("{:.3}", started.elapsed().as_secs_f64())),
         ("Sampler".to_string(), settings.sampler.to_string()),
     ];
     prism::output::save_frame(&frame, &args.output, args.exposure, args.tone_map, &metadata)?;
     if integrator.rejected_samples() > 0 {
-        eprintln!("warning: {} samples were NaN or infinite and were dropped", integrator.rejected_samples());
+        eprintln!(
+            "warning: {} samples were NaN or infinite and were dropped",
+            integrator.rejected_samples()
+        );
     }
     if !args.quiet {
-        eprintln!("wrote {} ({}x{}, {} passes of {})", args.output.display(), frame.width, frame.height, integrator.passes(), settings.integrator);
+        eprintln!(
+            "wrote {} ({}x{}, {} passes of {})",
+            args.output.display(),
+            frame.width,
+            frame.height,
+            integrator.passes(),
+            settings.integrator
+        );
     }
     Ok(())
 }

@@ -21,11 +21,7 @@ pub fn rmse(a: &Frame, b: &Frame) -> Result<f64, SizeMismatch> {
         .pixels
         .iter()
         .zip(&b.pixels)
-        .map(|(p, q)| {
-            (0..3)
-                .map(|c| (p[c] as f64 - q[c] as f64).powi(2))
-                .sum::<f64>()
-        })
+        .map(|(p, q)| (0..3).map(|c| (p[c] as f64 - q[c] as f64).powi(2)).sum::<f64>())
         .sum();
     Ok((squared / (3 * a.pixels.len()) as f64).sqrt())
 }

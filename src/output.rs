@@ -38,8 +38,16 @@ impl ImageFormat {
 
 /// Saves `frame`: 8-bit sRGB after exposure and tone mapping for PNG, BMP and
 /// PPM; linear 32-bit float for EXR. `metadata` goes into PNG text chunks.
-pub fn save_frame(frame: &Frame, path: &Path, exposure_stops: f64, tone_map: ToneMap, metadata: &[(String, String)]) -> Result<(), OutputError> {
-    let format = ImageFormat::from_path(path).ok_or_else(|| OutputError::UnsupportedFormat { path: path.to_path_buf() })?;
+pub fn save_frame(
+    frame: &Frame,
+    path: &Path,
+    exposure_stops: f64,
+    tone_map: ToneMap,
+    metadata: &[(String, String)],
+) -> Result<(), OutputError> {
+    let format = ImageFormat::from_path(path).ok_or_else(|| OutputError::UnsupportedFormat {
+        path: path.to_path_buf(),
+    })?;
     let failed = |message: String| OutputError::Write {
         path: path.to_path_buf(),
         message,
@@ -53,7 +61,8 @@ pub fn save_frame(frame: &Frame, path: &Path, exposure_stops: f64, tone_map: Ton
     }
     let file_name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let temporary = directory.join(format!(".{file_name}.{}.tmp", std::process::id()));
-    let result = write_to(frame, &temporary, format, exposure_stops, tone_map, metadata).and_then(|()| std::fs::rename(&temporary, path).map_err(|e| e.to_string()));
+    let result = write_to(frame, &temporary, format, exposure_stops, tone_map, metadata)
+        .and_then(|()| std::fs::rename(&temporary, path).map_err(|e| e.to_string()));
     if let Err(message) = result {
         let _ = std::fs::remove_file(&temporary);
         return Err(failed(message));
@@ -61,7 +70,14 @@ pub fn save_frame(frame: &Frame, path: &Path, exposure_stops: f64, tone_map: Ton
     Ok(())
 }
 
-fn write_to(frame: &Frame, path: &Path, format: ImageFormat, exposure_stops: f64, tone_map: ToneMap, metadata: &[(String, String)]) -> Result<(), String> {
+fn write_to(
+    frame: &Frame,
+    path: &Path,
+    format: ImageFormat,
+    exposure_stops: f64,
+    tone_map: ToneMap,
+    metadata: &[(String, String)],
+) -> Result<(), String> {
     let (width, height) = (frame.width, frame.height);
     match format {
         ImageFormat::Exr => write_exr(frame, path, exposure_stops, metadata),
@@ -73,7 +89,9 @@ fn write_to(frame: &Frame, path: &Path, format: ImageFormat, exposure_stops: f64
             encoder.set_depth(png::BitDepth::Eight);
             encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
             for (key, value) in metadata {
-                encoder.add_text_chunk(key.clone(), value.clone()).map_err(|e| e.to_string())?;
+                encoder
+                    .add_text_chunk(key.clone(), value.clone())
+                    .map_err(|e| e.to_string())?;
             }
             let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
             writer.write_image_data(&data).map_err(|e| e.to_string())?;
@@ -82,7 +100,11 @@ fn write_to(frame: &Frame, path: &Path, format: ImageFormat, exposure_stops: f64
         ImageFormat::Bmp | ImageFormat::Ppm => {
             let data: Vec<u8> = frame.to_srgb8(exposure_stops, tone_map).into_iter().flatten().collect();
             let buffer = image::RgbImage::from_raw(width, height, data).ok_or("frame size mismatch")?;
-            let format = if format == ImageFormat::Bmp { image::ImageFormat::Bmp } else { image::ImageFormat::Pnm };
+            let format = if format == ImageFormat::Bmp {
+                image::ImageFormat::Bmp
+            } else {
+                image::ImageFormat::Pnm
+            };
             let mut writer = BufWriter::new(File::create(path).map_err(|e| e.to_string())?);
             let mut bytes = std::io::Cursor::new(Vec::new());
             buffer.write_to(&mut bytes, format).map_err(|e| e.to_string())?;
@@ -120,7 +142,10 @@ fn write_exr(frame: &Frame, path: &Path, exposure_stops: f64, metadata: &[(Strin
 /// formats are sRGB-decoded). Used by benchmarks and tests.
 pub fn load_frame(path: &Path) -> Result<Frame, String> {
     let image = image::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let is_float = matches!(image, image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_));
+    let is_float = matches!(
+        image,
+        image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
+    );
     let rgb = image.to_rgb32f();
     let (width, height) = rgb.dimensions();
     let pixels = rgb

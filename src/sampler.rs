@@ -108,7 +108,10 @@ fn to_unit(bits: u32) -> f64 {
 /// bit of `index`. The map is linear over XOR, so it is tabulated per byte.
 fn sobol_second_dimension_reversed(index: u32) -> u32 {
     let t = &SOBOL_SECOND_DIMENSION_REVERSED;
-    t[0][(index & 0xff) as usize] ^ t[1][((index >> 8) & 0xff) as usize] ^ t[2][((index >> 16) & 0xff) as usize] ^ t[3][(index >> 24) as usize]
+    t[0][(index & 0xff) as usize]
+        ^ t[1][((index >> 8) & 0xff) as usize]
+        ^ t[2][((index >> 16) & 0xff) as usize]
+        ^ t[3][(index >> 24) as usize]
 }
 
 const SOBOL_SECOND_DIMENSION_REVERSED: [[u32; 256]; 4] = {
@@ -210,7 +213,10 @@ mod tests {
     #[test]
     fn fast_sobol_equals_the_definition() {
         for index in [0u32, 1, 2, 3, 77, 1 << 20, u32::MAX, 0x1234_5678] {
-            assert_eq!(sobol_second_dimension_reversed(index), sobol_second_dimension(index).reverse_bits());
+            assert_eq!(
+                sobol_second_dimension_reversed(index),
+                sobol_second_dimension(index).reverse_bits()
+            );
         }
         let (pixel, sample, seed) = (12u64, 37u32, 5u64);
         let mut fast = Sampler::new(SamplerKind::Sobol, pixel, sample, seed);
@@ -237,7 +243,10 @@ mod tests {
     #[test]
     fn random_sampler_has_uniform_mean() {
         let n = 100_000;
-        let mean: f64 = (0..n).map(|i| Sampler::new(SamplerKind::Random, 9, i, 0).next_1d()).sum::<f64>() / n as f64;
+        let mean: f64 = (0..n)
+            .map(|i| Sampler::new(SamplerKind::Random, 9, i, 0).next_1d())
+            .sum::<f64>()
+            / n as f64;
         // Standard error of the mean of U(0,1) is 1/sqrt(12 n) ≈ 0.0009; allow 5σ.
         assert!((mean - 0.5).abs() < 0.0046);
     }

@@ -3,7 +3,8 @@
 # waits for its first image plus a few seconds of accumulation, takes a
 # screenshot of the screen and fails if the image region is blank or uniform
 # (ImageMagick's standard deviation of the cropped region), or if the viewer
-# died. Prints the viewer's timing log (PRISM_VIEWER_LOG=1).
+# died. Prints the viewer's timing log (PRISM_VIEWER_LOG=2: events, and the
+# frame rate the UI sustains while repainting continuously).
 #
 # Environment: PRISM_BIN (default: builds and uses target/debug/prism),
 # SCREENSHOT (default: target/gui-smoke/viewer.png), SETTLE_SECONDS (default 4).
@@ -36,7 +37,7 @@ export bin screenshot settle log
 # Mesa's software rasteriser; one thread so the renderer keeps the cores.
 export LIBGL_ALWAYS_SOFTWARE=1 LP_NUM_THREADS=1
 xvfb-run -a -s "-screen 0 1280x800x24" bash -c '
-    PRISM_VIEWER_LOG=1 "$bin" 2>"$log" &
+    PRISM_VIEWER_LOG=${PRISM_VIEWER_LOG:-2} "$bin" 2>"$log" &
     pid=$!
     for _ in $(seq 1 600); do
         grep -q "first image shown" "$log" && break

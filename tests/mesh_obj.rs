@@ -33,7 +33,11 @@ fn normals_uv_and_transform_are_applied() {
     assert!((hit.t - 5.0).abs() < 1e-12);
     assert!((hit.uv - DVec2::new(0.5, 0.5)).length() < 1e-12, "uv {}", hit.uv);
     // Halfway between normal (0,0,1) and (1,0,1)/√2 in the barycentric sense.
-    assert!(hit.shading_normal.x > 0.2 && hit.shading_normal.x < 0.6, "{}", hit.shading_normal);
+    assert!(
+        hit.shading_normal.x > 0.2 && hit.shading_normal.x < 0.6,
+        "{}",
+        hit.shading_normal
+    );
     assert_eq!(hit.geometric_normal, DVec3::Z);
 }
 

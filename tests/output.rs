@@ -7,7 +7,14 @@ fn frame() -> Frame {
     Frame {
         width: 3,
         height: 2,
-        pixels: vec![[0.0, 0.25, 0.5], [1.0, 2.0, 4.0], [0.1, 0.2, 0.3], [0.9, 0.8, 0.7], [0.01, 0.02, 0.03], [0.5, 0.5, 0.5]],
+        pixels: vec![
+            [0.0, 0.25, 0.5],
+            [1.0, 2.0, 4.0],
+            [0.1, 0.2, 0.3],
+            [0.9, 0.8, 0.7],
+            [0.01, 0.02, 0.03],
+            [0.5, 0.5, 0.5],
+        ],
         noise: Vec::new(),
     }
 }
@@ -48,7 +55,10 @@ fn png_bmp_ppm_round_trip_within_8_bit_quantisation() {
     }
     let png = std::fs::read(dir().join("b.png")).expect("read");
     let needle = b"scenes/cornell.toml";
-    assert!(png.windows(needle.len()).any(|w| w == needle), "PNG text chunk with the scene");
+    assert!(
+        png.windows(needle.len()).any(|w| w == needle),
+        "PNG text chunk with the scene"
+    );
 }
 
 #[test]
@@ -60,7 +70,11 @@ fn failed_write_leaves_nothing_behind() {
     std::fs::create_dir_all(&target).expect("dir");
     let result = save_frame(&frame(), &target, 0.0, ToneMap::Clamp, &[]);
     assert!(result.is_err());
-    let leftovers: Vec<_> = std::fs::read_dir(&folder).expect("list").filter_map(Result::ok).map(|e| e.file_name()).collect();
+    let leftovers: Vec<_> = std::fs::read_dir(&folder)
+        .expect("list")
+        .filter_map(Result::ok)
+        .map(|e| e.file_name())
+        .collect();
     assert_eq!(leftovers.len(), 1, "temporary file left behind: {leftovers:?}");
     let unsupported = save_frame(&frame(), &folder.join("d.jpg"), 0.0, ToneMap::Clamp, &[]);
     assert!(unsupported.is_err_and(|e| e.to_string().contains("d.jpg")));

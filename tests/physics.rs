@@ -42,7 +42,14 @@ fn white_furnace_is_one_with_light_sampling_and_without() {
         "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 3\nmaterial = \"white\"",
     ));
     for integrator in [IntegratorKind::PathTracing, IntegratorKind::BsdfOnly] {
-        let frame = render(&loaded, &Job { spp: 64, integrator, ..Job::default() });
+        let frame = render(
+            &loaded,
+            &Job {
+                spp: 64,
+                integrator,
+                ..Job::default()
+            },
+        );
         for (c, mean) in frame.channel_means().into_iter().enumerate() {
             assert!((mean - 1.0).abs() < 0.005, "{integrator}: channel {c} mean {mean}");
         }
@@ -60,7 +67,14 @@ fn glass_neither_gains_nor_loses_energy() {
         "[materials.glass]\ntype = \"glass\"\nior = 1.5",
         "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 3\nmaterial = \"glass\"",
     ));
-    let (mean, error) = mean_and_error(&loaded, &Job { spp: 16, ..Job::default() }, 6);
+    let (mean, error) = mean_and_error(
+        &loaded,
+        &Job {
+            spp: 16,
+            ..Job::default()
+        },
+        6,
+    );
     for c in 0..3 {
         assert!(3.0 * error[c] < 0.01, "estimate too noisy to test: {error:?}");
         assert!((mean[c] - 1.0).abs() < 0.01, "channel {c}: mean {} ± {}", mean[c], error[c]);
@@ -73,9 +87,29 @@ fn glass_neither_gains_nor_loses_energy() {
 #[test]
 fn light_sampling_and_bsdf_sampling_agree_on_cornell() {
     let loaded = shipped_scene("cornell.toml");
-    let job = Job { width: 24, height: 24, spp: 32, max_depth: 32, ..Job::default() };
-    let (nee, nee_error) = mean_and_error(&loaded, &Job { integrator: IntegratorKind::PathTracing, ..job }, 8);
-    let (bsdf, bsdf_error) = mean_and_error(&loaded, &Job { integrator: IntegratorKind::BsdfOnly, ..job }, 8);
+    let job = Job {
+        width: 24,
+        height: 24,
+        spp: 32,
+        max_depth: 32,
+        ..Job::default()
+    };
+    let (nee, nee_error) = mean_and_error(
+        &loaded,
+        &Job {
+            integrator: IntegratorKind::PathTracing,
+            ..job
+        },
+        8,
+    );
+    let (bsdf, bsdf_error) = mean_and_error(
+        &loaded,
+        &Job {
+            integrator: IntegratorKind::BsdfOnly,
+            ..job
+        },
+        8,
+    );
     for c in 0..3 {
         let combined = (nee_error[c].powi(2) + bsdf_error[c].powi(2)).sqrt();
         assert!(
@@ -97,9 +131,29 @@ fn light_sampling_and_bsdf_sampling_agree_on_cornell() {
 #[test]
 fn light_sampling_reduces_variance() {
     let loaded = shipped_scene("cornell.toml");
-    let job = Job { width: 16, height: 16, spp: 8, max_depth: 16, ..Job::default() };
-    let (_, nee_error) = mean_and_error(&loaded, &Job { integrator: IntegratorKind::PathTracing, ..job }, 6);
-    let (_, bsdf_error) = mean_and_error(&loaded, &Job { integrator: IntegratorKind::BsdfOnly, ..job }, 6);
+    let job = Job {
+        width: 16,
+        height: 16,
+        spp: 8,
+        max_depth: 16,
+        ..Job::default()
+    };
+    let (_, nee_error) = mean_and_error(
+        &loaded,
+        &Job {
+            integrator: IntegratorKind::PathTracing,
+            ..job
+        },
+        6,
+    );
+    let (_, bsdf_error) = mean_and_error(
+        &loaded,
+        &Job {
+            integrator: IntegratorKind::BsdfOnly,
+            ..job
+        },
+        6,
+    );
     assert!(nee_error[1] < bsdf_error[1], "NEE {nee_error:?} vs BSDF {bsdf_error:?}");
 }
 
@@ -138,13 +192,40 @@ profile = [[0.0, 0.5], [3.0, 1.0], [0.2, 2.5], [1.0, 3.5]]
 material = "lamp"
 "#,
     );
-    let job = Job { width: 24, height: 16, spp: 32, max_depth: 8, ..Job::default() };
-    let (nee, nee_error) = mean_and_error(&loaded, &Job { integrator: IntegratorKind::PathTracing, ..job }, 8);
-    let (bsdf, bsdf_error) = mean_and_error(&loaded, &Job { integrator: IntegratorKind::BsdfOnly, ..job }, 8);
+    let job = Job {
+        width: 24,
+        height: 16,
+        spp: 32,
+        max_depth: 8,
+        ..Job::default()
+    };
+    let (nee, nee_error) = mean_and_error(
+        &loaded,
+        &Job {
+            integrator: IntegratorKind::PathTracing,
+            ..job
+        },
+        8,
+    );
+    let (bsdf, bsdf_error) = mean_and_error(
+        &loaded,
+        &Job {
+            integrator: IntegratorKind::BsdfOnly,
+            ..job
+        },
+        8,
+    );
     eprintln!("revolution light: NEE {nee:?} ± {nee_error:?}, BSDF {bsdf:?} ± {bsdf_error:?}");
     for c in 0..3 {
         let combined = (nee_error[c].powi(2) + bsdf_error[c].powi(2)).sqrt();
-        assert!((nee[c] - bsdf[c]).abs() < 3.0 * combined, "channel {c}: NEE {} ± {}, BSDF {} ± {}", nee[c], nee_error[c], bsdf[c], bsdf_error[c]);
+        assert!(
+            (nee[c] - bsdf[c]).abs() < 3.0 * combined,
+            "channel {c}: NEE {} ± {}, BSDF {} ± {}",
+            nee[c],
+            nee_error[c],
+            bsdf[c],
+            bsdf_error[c]
+        );
         assert!(nee[c] > 0.05 && combined < 0.05 * nee[c], "channel {c}: {nee:?} ± {combined}");
     }
 }

@@ -23,9 +23,30 @@ fn rmse(a: &Frame, b: &Frame) -> f64 {
 #[test]
 fn sobol_beats_random_at_equal_samples_on_smallpt() {
     let loaded = shipped_scene("smallpt.toml");
-    let base = Job { width: 32, height: 24, max_depth: 12, ..Job::default() };
-    let reference_sobol = render(&loaded, &Job { spp: 1024, seed: 1000, sampler: SamplerKind::Sobol, ..base });
-    let reference_random = render(&loaded, &Job { spp: 1024, seed: 1001, sampler: SamplerKind::Random, ..base });
+    let base = Job {
+        width: 32,
+        height: 24,
+        max_depth: 12,
+        ..Job::default()
+    };
+    let reference_sobol = render(
+        &loaded,
+        &Job {
+            spp: 1024,
+            seed: 1000,
+            sampler: SamplerKind::Sobol,
+            ..base
+        },
+    );
+    let reference_random = render(
+        &loaded,
+        &Job {
+            spp: 1024,
+            seed: 1001,
+            sampler: SamplerKind::Random,
+            ..base
+        },
+    );
     let mut reference = reference_sobol.clone();
     for (p, q) in reference.pixels.iter_mut().zip(&reference_random.pixels) {
         for c in 0..3 {
@@ -33,7 +54,22 @@ fn sobol_beats_random_at_equal_samples_on_smallpt() {
         }
     }
     let errors = |sampler| -> Vec<f64> {
-        (1..=8).map(|seed| rmse(&render(&loaded, &Job { spp: 16, seed, sampler, ..base }), &reference)).collect()
+        (1..=8)
+            .map(|seed| {
+                rmse(
+                    &render(
+                        &loaded,
+                        &Job {
+                            spp: 16,
+                            seed,
+                            sampler,
+                            ..base
+                        },
+                    ),
+                    &reference,
+                )
+            })
+            .collect()
     };
     let stats = |e: &[f64]| {
         let n = e.len() as f64;
@@ -43,6 +79,12 @@ fn sobol_beats_random_at_equal_samples_on_smallpt() {
     };
     let (sobol, sobol_error) = stats(&errors(SamplerKind::Sobol));
     let (random, random_error) = stats(&errors(SamplerKind::Random));
-    eprintln!("smallpt 32x24, 16 spp, 8 seeds: RMSE sobol {sobol:.4} ± {sobol_error:.4}, random {random:.4} ± {random_error:.4}, ratio {:.3}", sobol / random);
-    assert!(sobol + 2.0 * (sobol_error + random_error) < random, "sobol {sobol} ± {sobol_error}, random {random} ± {random_error}");
+    eprintln!(
+        "smallpt 32x24, 16 spp, 8 seeds: RMSE sobol {sobol:.4} ± {sobol_error:.4}, random {random:.4} ± {random_error:.4}, ratio {:.3}",
+        sobol / random
+    );
+    assert!(
+        sobol + 2.0 * (sobol_error + random_error) < random,
+        "sobol {sobol} ± {sobol_error}, random {random} ± {random_error}"
+    );
 }

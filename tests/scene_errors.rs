@@ -42,7 +42,10 @@ fn check(name: &str, text: &str, line: usize, field: &str, words: &str) {
     let lines: Vec<&str> = stderr.lines().collect();
     assert_eq!(lines.len(), 1, "{name}: expected one line, got {stderr:?}");
     let expected_location = format!("{}:{line}:", path.display());
-    assert!(lines[0].contains(&expected_location), "{name}: no {expected_location} in {stderr:?}");
+    assert!(
+        lines[0].contains(&expected_location),
+        "{name}: no {expected_location} in {stderr:?}"
+    );
     assert!(lines[0].contains(field), "{name}: no field {field} in {stderr:?}");
     assert!(lines[0].contains(words), "{name}: no '{words}' in {stderr:?}");
 }
@@ -57,7 +60,13 @@ fn syntax_error() {
 #[test]
 fn unknown_material() {
     let text = format!("{GOOD}\n[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"chrome\"\n");
-    check("material.toml", &text, 13, "objects[0].material", "unknown material \"chrome\"");
+    check(
+        "material.toml",
+        &text,
+        13,
+        "objects[0].material",
+        "unknown material \"chrome\"",
+    );
 }
 
 #[test]
@@ -80,7 +89,9 @@ fn nan_value() {
 
 #[test]
 fn unknown_field() {
-    let text = format!("{GOOD}\n[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"white\"\ncolour = [1, 0, 0]\n");
+    let text = format!(
+        "{GOOD}\n[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"white\"\ncolour = [1, 0, 0]\n"
+    );
     check("field.toml", &text, 14, "", "colour");
 }
 
@@ -88,10 +99,24 @@ fn unknown_field() {
 fn unwritable_output_is_a_clear_error() {
     let path = write_scene("fine.toml", GOOD);
     let output = Command::new(env!("CARGO_BIN_EXE_prism"))
-        .args(["render", "--quiet", "--spp", "1", "--width", "8", "--height", "8", "-o", "/nonexistent-folder/x.png"])
+        .args([
+            "render",
+            "--quiet",
+            "--spp",
+            "1",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "-o",
+            "/nonexistent-folder/x.png",
+        ])
         .arg(&path)
         .output()
         .expect("run prism");
     let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(!output.status.success() && stderr.contains("/nonexistent-folder/x.png") && !stderr.contains("panicked"), "{stderr}");
+    assert!(
+        !output.status.success() && stderr.contains("/nonexistent-folder/x.png") && !stderr.contains("panicked"),
+        "{stderr}"
+    );
 }

@@ -147,8 +147,10 @@ fn sppm_matches_path_traced_channel_means() {
     // radius: gather discs that reach over a corner lose the part that lies
     // on the perpendicular wall (whose photons the normal test rejects), and
     // light is blurred across the shadow boundaries. After 64 iterations the
-    // radius is ~2/3 of its start (1.5 pixel footprints), which leaves the
-    // image means about 1–2% low; 3% is that bias plus margin.
+    // radius is still ~0.4 of its start (1.5 pixel footprints, which at 32×32
+    // is ~4% of the box), which leaves the image means ~1.8% low (measured;
+    // at 64×64 it is 0.7%, falling to 0.4% after 512 iterations, as a bias
+    // that vanishes with the radius should). 3% is that bias plus margin.
     for c in 0..3 {
         let relative = sppm[c] / reference[c] - 1.0;
         println!(

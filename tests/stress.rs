@@ -28,10 +28,17 @@ fn extreme_scenes_have_no_nan_samples_self_intersections_or_leaks() {
     let rows = stress::run(&options(), |_| {}).expect("stress scenes load");
     // Every scene was probed by every check that applies to it.
     assert!(rows.iter().filter(|r| r.check == "self-intersections").count() == stress::stress_scenes().len());
-    assert!(rows.iter().any(|r| r.scene == "bunny-obj"), "the bunny's leak test did not run");
+    assert!(
+        rows.iter().any(|r| r.scene == "bunny-obj"),
+        "the bunny's leak test did not run"
+    );
     for row in &rows {
         assert!(row.tested > 0, "{} / {}: nothing tested", row.scene, row.check);
-        assert_eq!(row.failures, 0, "{} / {}: {} of {}", row.scene, row.check, row.failures, row.tested);
+        assert_eq!(
+            row.failures, 0,
+            "{} / {}: {} of {}",
+            row.scene, row.check, row.failures, row.tested
+        );
     }
 }
 
@@ -41,11 +48,19 @@ fn extreme_scenes_have_no_nan_samples_self_intersections_or_leaks() {
 #[test]
 fn the_self_intersection_count_catches_unoffset_rays() {
     let scenes = stress::stress_scenes();
-    let (_, text) = scenes.iter().find(|(name, _)| name.starts_with("smallpt")).expect("smallpt scene");
+    let (_, text) = scenes
+        .iter()
+        .find(|(name, _)| name.starts_with("smallpt"))
+        .expect("smallpt scene");
     let loaded = load_scene_str(text, Path::new("smallpt"), Path::new(".")).expect("loads");
-    let (spawned, self_hits) = stress::self_intersections_with(&loaded.scene, loaded.camera.position, 500, |hit, direction| Ray::new(hit.point, direction));
+    let (spawned, self_hits) = stress::self_intersections_with(&loaded.scene, &loaded.camera, 500, |hit, direction| {
+        Ray::new(hit.point, direction)
+    });
     assert!(spawned > 0);
-    assert!(self_hits > 0, "naive spawning should re-hit its surface sometimes ({spawned} rays)");
+    assert!(
+        self_hits > 0,
+        "naive spawning should re-hit its surface sometimes ({spawned} rays)"
+    );
 }
 
 /// Negative control: a sphere mesh with one face removed must leak rays

@@ -20,9 +20,10 @@ use std::sync::Arc;
 
 const TOLERANCE: f64 = 1e-6;
 
-/// A scratch folder for this test binary's images and scenes.
+/// A scratch folder for this test process's images and scenes (per process, so
+/// two concurrent runs never read each other's half-written files).
 fn scratch() -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("prism-textures");
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("prism-textures-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("create scratch folder");
     dir
 }
@@ -307,6 +308,10 @@ fn a_missing_or_corrupt_image_is_a_located_error_naming_the_file() {
 #[test]
 fn misplaced_or_invalid_texture_keys_are_located_errors() {
     let cases = [
+        (
+            "{ gradient = [[1, 1, 1], [0, 0, 0]], center = [0, 0, 0] }",
+            "materials.m.albedo.center: does not apply to gradient textures (only to image, checker)",
+        ),
         (
             "{ checker = [[1, 1, 1], [0, 0, 0]], wrap = \"clamp\" }",
             "materials.m.albedo.wrap: does not apply to checker textures (only to image)",

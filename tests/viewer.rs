@@ -24,8 +24,10 @@ fn start(scene: Option<PathBuf>) -> Harness<'static, ViewerApp> {
     let start = ViewerStart {
         scene,
         render_threads: 1,
+        render_niceness: 0,
         resolution_scale: 0.125,
         log: false,
+        continuous_repaint: false,
     };
     // The render thread's wake-ups go to a context of their own: the test steps the UI itself.
     let app = ViewerApp::new(&egui::Context::default(), start, Instant::now()).expect("viewer starts");
@@ -67,32 +69,24 @@ fn aperture_slider_changes_the_render_threads_camera_and_restarts() {
     let before = harness.state().displayed_frame().cloned().expect("frame");
     assert_eq!(before.camera.aperture_radius, 0.0, "the default scene starts as a pinhole");
 
-    // Drag the slider from its left end to 60 % of its width.
-    let rect = harness.get_by_role_and_label(Role::Slider, "Aperture radius").rect();
-    let from = rect.left_center() + Vec2::new(2.0, 0.0);
-    let to = rect.lerp_inside(Vec2::new(0.6, 0.5));
-    harness.event(Event::PointerMoved(from));
-    press(&harness, from, true);
+    // A camera-only change: set the slider's value (as assistive technology
+    // does), so no drag makes the resolution coarse meanwhile.
+    harness
+        .get_by_role_and_label(Role::Slider, "Aperture radius")
+        .set_value_accesskit(12.5);
     harness.step();
-    for t in [0.25, 0.5, 0.75, 1.0] {
-        harness.event(Event::PointerMoved(from + (to - from) * t));
-        harness.step();
-    }
-    press(&harness, to, false);
-    harness.step();
-
-    let aperture = harness.state().camera().expect("camera").aperture_radius;
-    assert!(aperture > 0.0, "the drag moved the slider");
+    assert_eq!(harness.state().camera().expect("camera").aperture_radius, 12.5);
     // The render thread's own camera is the new one…
     step_until(&mut harness, "the render thread's camera", |app| {
-        app.render_stats().camera.is_some_and(|c| c.aperture_radius == aperture)
+        app.render_stats().camera.is_some_and(|c| c.aperture_radius == 12.5)
     });
     // …and the frames it publishes with it belong to a restarted accumulation.
     step_until(&mut harness, "a frame with the new aperture", |app| {
         app.displayed_frame()
-            .is_some_and(|f| f.camera.aperture_radius == aperture && !f.preview && f.settings.width == 64)
+            .is_some_and(|f| f.camera.aperture_radius == 12.5 && !f.preview)
     });
     let after = harness.state().displayed_frame().cloned().expect("frame");
+    assert_eq!(after.settings, before.settings, "only the camera changed");
     assert!(
         after.generation > before.generation,
         "generation {} → {}",
@@ -109,6 +103,29 @@ fn aperture_slider_changes_the_render_threads_camera_and_restarts() {
         after.sequence - before.sequence,
         before.passes
     );
+
+    // Dragging the slider renders coarse while the mouse is down, then refines.
+    let rect = harness.get_by_role_and_label(Role::Slider, "Aperture radius").rect();
+    let from = rect.left_center() + Vec2::new(2.0, 0.0);
+    let to = rect.lerp_inside(Vec2::new(0.6, 0.5));
+    harness.event(Event::PointerMoved(from));
+    press(&harness, from, true);
+    harness.step();
+    for t in [0.25, 0.5, 0.75, 1.0] {
+        harness.event(Event::PointerMoved(from + (to - from) * t));
+        harness.step();
+    }
+    step_until(&mut harness, "a coarse render while dragging", |app| {
+        app.render_stats().settings.width < 64
+    });
+    press(&harness, to, false);
+    harness.step();
+    let dragged = harness.state().camera().expect("camera").aperture_radius;
+    assert!(dragged > 0.0 && dragged != 12.5, "the drag moved the slider to {dragged}");
+    step_until(&mut harness, "the refined render with the dragged aperture", |app| {
+        app.displayed_frame()
+            .is_some_and(|f| f.camera.aperture_radius == dragged && f.settings.width == 64 && !f.preview)
+    });
 }
 
 #[test]

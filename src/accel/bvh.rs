@@ -85,7 +85,11 @@ impl Bvh {
             return;
         }
         let inverse_direction = glam::DVec3::ONE / ray.direction;
-        let negative = [inverse_direction.x < 0.0, inverse_direction.y < 0.0, inverse_direction.z < 0.0];
+        let negative = [
+            inverse_direction.x < 0.0,
+            inverse_direction.y < 0.0,
+            inverse_direction.z < 0.0,
+        ];
         let mut stack = [0u32; 64];
         let mut stack_len = 0;
         let mut current = 0usize;
@@ -129,7 +133,9 @@ fn flatten(node: &BuildNode, nodes: &mut Vec<Node>) {
             count: *count as u16,
             axis: 0,
         }),
-        BuildNode::Interior { bounds, axis, children, .. } => {
+        BuildNode::Interior {
+            bounds, axis, children, ..
+        } => {
             let index = nodes.len();
             nodes.push(Node {
                 bounds: *bounds,

@@ -47,15 +47,23 @@ impl Configuration {
     }
 
     /// The configurations that matter: NEE+MIS with Sobol' (the default), with
-    /// independent samples, and adaptive; BSDF sampling only; SPPM.
-    pub fn standard(adaptive_threshold: f64) -> Vec<Configuration> {
-        vec![
+    /// independent samples, and adaptive at each of `adaptive_thresholds`;
+    /// BSDF sampling only; SPPM.
+    pub fn standard(adaptive_thresholds: &[f64]) -> Vec<Configuration> {
+        let mut configurations = vec![
             Configuration::new(IntegratorKind::PathTracing, SamplerKind::Sobol, None),
             Configuration::new(IntegratorKind::PathTracing, SamplerKind::Random, None),
-            Configuration::new(IntegratorKind::PathTracing, SamplerKind::Sobol, Some(adaptive_threshold)),
-            Configuration::new(IntegratorKind::BsdfOnly, SamplerKind::Sobol, None),
-            Configuration::new(IntegratorKind::Sppm, SamplerKind::Sobol, None),
-        ]
+        ];
+        for &threshold in adaptive_thresholds {
+            configurations.push(Configuration::new(
+                IntegratorKind::PathTracing,
+                SamplerKind::Sobol,
+                Some(threshold),
+            ));
+        }
+        configurations.push(Configuration::new(IntegratorKind::BsdfOnly, SamplerKind::Sobol, None));
+        configurations.push(Configuration::new(IntegratorKind::Sppm, SamplerKind::Sobol, None));
+        configurations
     }
 
     /// `settings` with this configuration's choices applied, at `width`×`height`.
@@ -84,7 +92,8 @@ pub struct ErrorMetrics {
 
 /// Compares two frames of the same size.
 pub fn error_metrics(estimate: &Frame, reference: &Frame) -> Result<ErrorMetrics, BenchError> {
-    if (estimate.width, estimate.height) != (reference.width, reference.height) || estimate.pixels.len() != reference.pixels.len() {
+    if (estimate.width, estimate.height) != (reference.width, reference.height) || estimate.pixels.len() != reference.pixels.len()
+    {
         return Err(BenchError::Reference(format!(
             "size {}x{} differs from the estimate's {}x{}",
             reference.width, reference.height, estimate.width, estimate.height
@@ -151,7 +160,13 @@ fn is_fallback(kind: IntegratorKind, status: &str) -> bool {
 
 /// Renders with `settings` until the last rung of `ladder` and measures the
 /// error against `reference` at each rung. Runs on the current rayon pool.
-pub fn measure_curve(scene: &Scene, camera: &Camera, settings: &RenderSettings, reference: &Frame, ladder: &[f64]) -> Result<CurveOutcome, BenchError> {
+pub fn measure_curve(
+    scene: &Scene,
+    camera: &Camera,
+    settings: &RenderSettings,
+    reference: &Frame,
+    ladder: &[f64],
+) -> Result<CurveOutcome, BenchError> {
     let mut integrator = integrator::create(settings);
     let cancel = AtomicBool::new(false);
     let mut points = Vec::with_capacity(ladder.len());
@@ -162,7 +177,10 @@ pub fn measure_curve(scene: &Scene, camera: &Camera, settings: &RenderSettings, 
         integrator.render_pass(scene, camera, &cancel);
         render_seconds += start.elapsed().as_secs_f64();
         if integrator.passes() == 1 && is_fallback(settings.integrator, &integrator.status()) {
-            return Ok(CurveOutcome::Skipped(format!("{} is not available yet (integrator::create fell back to path tracing)", settings.integrator)));
+            return Ok(CurveOutcome::Skipped(format!(
+                "{} is not available yet (integrator::create fell back to path tracing)",
+                settings.integrator
+            )));
         }
         if render_seconds < ladder[next] {
             continue;
@@ -188,7 +206,9 @@ pub fn measure_curve(scene: &Scene, camera: &Camera, settings: &RenderSettings, 
 
 /// Where the small reference of a scene file lives: `<directory>/<stem>.exr`.
 pub fn reference_path(directory: &Path, scene_file: &Path) -> PathBuf {
-    let stem = scene_file.file_stem().map_or("scene".into(), |s| s.to_string_lossy().to_string());
+    let stem = scene_file
+        .file_stem()
+        .map_or("scene".into(), |s| s.to_string_lossy().to_string());
     directory.join(format!("{stem}.exr"))
 }
 
@@ -220,15 +240,22 @@ pub fn make_reference(loaded: &LoadedScene, settings: &RenderSettings, path: &Pa
     let integrator = render_progressive(&loaded.scene, &loaded.camera, settings, &cancel, |_, _| {});
     let metadata = vec![
         ("Software".to_string(), format!("prism {}", env!("CARGO_PKG_VERSION"))),
-        ("Scene".to_string(), loaded.path.as_ref().map_or("<embedded>".into(), |p| p.display().to_string())),
+        (
+            "Scene".to_string(),
+            loaded.path.as_ref().map_or("<embedded>".into(), |p| p.display().to_string()),
+        ),
         ("Integrator".to_string(), settings.integrator.to_string()),
         ("Sampler".to_string(), settings.sampler.to_string()),
         ("Seed".to_string(), settings.seed.to_string()),
         ("Passes".to_string(), integrator.passes().to_string()),
     ];
-    save_frame(&integrator.frame(), path, 0.0, ToneMap::Clamp, &metadata).map_err(|e| BenchError::Reference(format!("{}: {e}", path.display())))?;
+    save_frame(&integrator.frame(), path, 0.0, ToneMap::Clamp, &metadata)
+        .map_err(|e| BenchError::Reference(format!("{}: {e}", path.display())))?;
     if integrator.rejected_samples() > 0 {
-        return Err(BenchError::Reference(format!("{} samples were NaN or infinite", integrator.rejected_samples())));
+        return Err(BenchError::Reference(format!(
+            "{} samples were NaN or infinite",
+            integrator.rejected_samples()
+        )));
     }
     Ok(integrator.passes())
 }
@@ -286,7 +313,10 @@ impl SceneCurves {
             "rejected_samples",
             "status",
         ]);
-        csv.comments.push(format!("prism bench: error against the reference at doubling render times, {}x{} pixels, {threads} threads", self.width, self.height));
+        csv.comments.push(format!(
+            "prism bench: error against the reference at doubling render times, {}x{} pixels, {threads} threads",
+            self.width, self.height
+        ));
         csv.comments.push(machine.to_string());
         for (configuration, outcome) in &self.curves {
             match outcome {
@@ -333,7 +363,10 @@ impl SceneCurves {
             .collect();
         // Guide: the Monte Carlo rate, RMSE ∝ t^(-1/2), through the first curve's start.
         if let Some(first) = series.first().and_then(|s| s.points.first().copied()) {
-            let end = series.iter().flat_map(|s| s.points.iter().map(|p| p.0)).fold(first.0, f64::max);
+            let end = series
+                .iter()
+                .flat_map(|s| s.points.iter().map(|p| p.0))
+                .fold(first.0, f64::max);
             series.push(Series {
                 name: "∝ t^-1/2".into(),
                 points: vec![first, (end, first.1 * (first.0 / end).sqrt())],
@@ -348,5 +381,46 @@ impl SceneCurves {
             log_y: true,
             series,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn frame(pixels: Vec<[f32; 3]>) -> Frame {
+        Frame {
+            width: pixels.len() as u32,
+            height: 1,
+            pixels,
+            noise: Vec::new(),
+        }
+    }
+
+    /// Hand-computed values (exact in f32/f64 up to rounding, tolerance 1e-12).
+    #[test]
+    fn metrics_match_their_definitions() {
+        let reference = frame(vec![[1.0, 0.0, 0.5], [0.0, 0.0, 0.0]]);
+        let estimate = frame(vec![[2.0, 0.0, 0.5], [0.0, 0.5, 0.0]]);
+        let m = error_metrics(&estimate, &reference).expect("same size");
+        // Squared errors 1 and 0.25 over 6 values.
+        assert!((m.rmse - (1.25f64 / 6.0).sqrt()).abs() < 1e-12);
+        // relMSE: 1 / (1 + 0.01) and 0.25 / (0 + 0.01), over 6 values.
+        assert!((m.relative_mse - (1.0 / 1.01 + 25.0) / 6.0).abs() < 1e-12);
+        assert_eq!(m.bias, [0.5, 0.25, 0.0]);
+        assert!(error_metrics(&frame(vec![[0.0; 3]]), &reference).is_err());
+    }
+
+    #[test]
+    fn ladder_doubles_up_to_the_last_rung() {
+        assert_eq!(time_ladder(0.5, 8.0), vec![0.5, 1.0, 2.0, 4.0, 8.0]);
+        assert_eq!(time_ladder(1.0, 64.0).len(), 7);
+    }
+
+    #[test]
+    fn fallback_is_detected_only_for_sppm() {
+        assert!(is_fallback(IntegratorKind::Sppm, ""));
+        assert!(!is_fallback(IntegratorKind::Sppm, "radius 0.01"));
+        assert!(!is_fallback(IntegratorKind::PathTracing, ""));
     }
 }

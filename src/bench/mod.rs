@@ -36,7 +36,10 @@ pub enum BenchError {
 /// One line describing the machine and its load, for CSV headers: the
 /// benchmarks share a machine, and a time means little without its load.
 pub fn machine_note() -> String {
-    let load = std::fs::read_to_string("/proc/loadavg").map_or_else(|_| "unknown".to_string(), |s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "));
+    let load = std::fs::read_to_string("/proc/loadavg").map_or_else(
+        |_| "unknown".to_string(),
+        |s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "),
+    );
     let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
     format!("{cores} logical cores, load average (1/5/15 min) {load}")
 }
@@ -97,4 +100,24 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), BenchError> {
 /// A float for CSV: enough digits to plot, no thousands of them.
 pub fn format_number(x: f64) -> String {
     format!("{x:.6e}")
+}
+
+/// CPU time the calling thread has spent running, from Linux's
+/// `/proc/thread-self/schedstat` (nanoseconds on CPU); `None` elsewhere.
+/// On a machine shared with other work, a single-threaded measurement's CPU
+/// time is far steadier than its wall time.
+pub fn thread_cpu_seconds() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    let nanoseconds: f64 = text.split_whitespace().next()?.parse().ok()?;
+    Some(nanoseconds * 1e-9)
+}
+
+/// Wall and (where known) thread CPU time of `work`, in seconds.
+pub fn time_thread<T>(work: impl FnOnce() -> T) -> (T, f64, Option<f64>) {
+    let cpu_start = thread_cpu_seconds();
+    let wall_start = std::time::Instant::now();
+    let result = work();
+    let wall = wall_start.elapsed().as_secs_f64();
+    let cpu = cpu_start.and_then(|start| Some(thread_cpu_seconds()? - start));
+    (result, wall, cpu)
 }

@@ -21,7 +21,7 @@ const HEIGHT: u32 = 640;
 pub struct Series {
     pub name: String,
     pub points: Vec<(f64, f64)>,
-    /// Drawn dashed-looking (thin, no markers): for guide lines such as n log n.
+    /// Drawn thin, grey and without markers: for guide lines such as n log n.
     pub guide: bool,
 }
 
@@ -59,7 +59,11 @@ fn tick_label(v: f64, log: bool) -> String {
         // Three significant digits, trailing zeros trimmed.
         let decimals = (2 - magnitude.log10().floor() as i32).max(0) as usize;
         let text = format!("{value:.decimals$}");
-        if text.contains('.') { text.trim_end_matches('0').trim_end_matches('.').to_string() } else { text }
+        if text.contains('.') {
+            text.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            text
+        }
     }
 }
 
@@ -112,7 +116,11 @@ impl LinePlot {
             .series
             .iter()
             .map(|s| {
-                let points = s.points.iter().filter_map(|&(x, y)| Some((coordinate(x, self.log_x)?, coordinate(y, self.log_y)?))).collect();
+                let points = s
+                    .points
+                    .iter()
+                    .filter_map(|&(x, y)| Some((coordinate(x, self.log_x)?, coordinate(y, self.log_y)?)))
+                    .collect();
                 (s, points)
             })
             .collect();
@@ -131,7 +139,13 @@ impl LinePlot {
         let (log_x, log_y) = (self.log_x, self.log_y);
         let x_format = move |v: &f64| tick_label(*v, log_x);
         let y_format = move |v: &f64| tick_label(*v, log_y);
-        let axis_note = |label: &str, log: bool| if log { format!("{label} (log scale)") } else { label.to_string() };
+        let axis_note = |label: &str, log: bool| {
+            if log {
+                format!("{label} (log scale)")
+            } else {
+                label.to_string()
+            }
+        };
         chart
             .configure_mesh()
             .x_desc(axis_note(&self.x_label, log_x))
@@ -146,7 +160,11 @@ impl LinePlot {
 
         for (index, (s, points)) in series.iter().enumerate() {
             let color = Palette99::pick(index).to_rgba();
-            let style = if s.guide { color.mix(0.5).stroke_width(1) } else { color.stroke_width(2) };
+            let style = if s.guide {
+                BLACK.mix(0.5).stroke_width(1)
+            } else {
+                color.stroke_width(2)
+            };
             chart
                 .draw_series(LineSeries::new(points.iter().copied(), style))
                 .map_err(|e| e.to_string())?

@@ -33,7 +33,8 @@ pub fn sphere_mesh(target_triangles: u32, center: DVec3, radius: f64) -> Mesh {
     let segments = ((target_triangles as f64).sqrt().round() as u32 + 2).max(4);
     let rings = (segments / 2).max(2);
     let mut mesh = Mesh::default();
-    let point = |theta: f64, phi: f64| center + radius * DVec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+    let point =
+        |theta: f64, phi: f64| center + radius * DVec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
     mesh.positions.push(center + DVec3::new(0.0, radius, 0.0));
     for ring in 1..rings {
         let theta = PI * ring as f64 / rings as f64;
@@ -48,7 +49,12 @@ pub fn sphere_mesh(target_triangles: u32, center: DVec3, radius: f64) -> Mesh {
         mesh.faces.push([0, vertex(1, s), vertex(1, s + 1)]);
         mesh.faces.push([south, vertex(rings - 1, s + 1), vertex(rings - 1, s)]);
         for ring in 1..rings - 1 {
-            let (a, b, c, d) = (vertex(ring, s), vertex(ring, s + 1), vertex(ring + 1, s), vertex(ring + 1, s + 1));
+            let (a, b, c, d) = (
+                vertex(ring, s),
+                vertex(ring, s + 1),
+                vertex(ring + 1, s),
+                vertex(ring + 1, s + 1),
+            );
             mesh.faces.push([a, c, b]);
             mesh.faces.push([b, c, d]);
         }
@@ -70,7 +76,13 @@ pub fn orient_outward(mesh: &mut Mesh, inside: DVec3) {
 
 /// A scene of one mesh with a grey diffuse material and no lights.
 pub fn mesh_scene(mesh: Mesh) -> Scene {
-    let primitives: Vec<Primitive> = mesh.triangles(0).map(|t| Primitive { shape: Shape::Triangle(t), material: 0 }).collect();
+    let primitives: Vec<Primitive> = mesh
+        .triangles(0)
+        .map(|t| Primitive {
+            shape: Shape::Triangle(t),
+            material: 0,
+        })
+        .collect();
     let materials = vec![Material::Diffuse {
         albedo: Texture::Constant(Color::splat(0.5)),
     }];
@@ -82,59 +94,77 @@ pub fn mesh_scene(mesh: Mesh) -> Scene {
 pub struct BvhRow {
     pub triangles: usize,
     pub nodes: usize,
-    /// Fastest of several builds (the least disturbed by other load).
+    /// Mean of repeated single-threaded builds, in thread CPU time where
+    /// known (else wall time), which other load barely disturbs.
     pub build_seconds: f64,
+    pub build_wall_seconds: f64,
     pub rays: u64,
+    /// Single-threaded nearest-hit cost, CPU time where known.
     pub ns_per_ray: f64,
+    pub wall_ns_per_ray: f64,
     pub hit_fraction: f64,
 }
 
 /// Builds BVHs over spheres of each triangle count and traces `rays` camera-like
-/// rays (about 70% hitting) through each, on the current thread.
-pub fn measure_bvh(triangle_counts: &[u32], rays: u64, mut progress: impl FnMut(&BvhRow)) -> Vec<BvhRow> {
+/// rays (about 78% hitting) through each, all on one worker thread.
+pub fn measure_bvh(triangle_counts: &[u32], rays: u64, mut progress: impl FnMut(&BvhRow)) -> Result<Vec<BvhRow>, BenchError> {
+    // One thread: the builder's rayon::join stays on it, so its CPU time is the build's.
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
     let mut rows = Vec::new();
     for &target in triangle_counts {
         let scene = mesh_scene(sphere_mesh(target, DVec3::ZERO, 1.0));
         let bounds: Vec<Aabb> = scene.primitives.iter().map(|p| p.shape.bounds()).collect();
-        // Repeat small builds so each measurement spans at least ~0.3 s.
-        let repetitions = (300_000 / bounds.len().max(1)).clamp(1, 50);
-        let mut build_seconds = f64::INFINITY;
-        let mut nodes = 0;
-        for _ in 0..repetitions {
-            let start = Instant::now();
-            let (bvh, _) = Bvh::build(&bounds);
-            build_seconds = build_seconds.min(start.elapsed().as_secs_f64());
-            nodes = bvh.node_count();
-        }
-        let (seconds, hits) = trace_rays(&scene, rays);
+        // Repeat small builds so the total spans ~0.3 s or more: the CPU
+        // clock advances in scheduler ticks (a few ms), too coarse for one build.
+        let repetitions = (3_000_000 / bounds.len().max(1)).clamp(1, 3000);
+        let (nodes, wall, cpu) = pool.install(|| {
+            super::time_thread(|| {
+                let mut nodes = 0;
+                for _ in 0..repetitions {
+                    nodes = Bvh::build(&bounds).0.node_count();
+                }
+                nodes
+            })
+        });
+        let build_wall_seconds = wall / repetitions as f64;
+        let build_seconds = cpu.map_or(build_wall_seconds, |c| c / repetitions as f64);
+        let probes = probe_rays(rays);
+        let (hits, wall, cpu) = pool.install(|| super::time_thread(|| count_hits(&scene, &probes)));
+        let per_ray = 1e9 / rays.max(1) as f64;
         let row = BvhRow {
             triangles: bounds.len(),
             nodes,
             build_seconds,
+            build_wall_seconds,
             rays,
-            ns_per_ray: seconds * 1e9 / rays.max(1) as f64,
+            ns_per_ray: cpu.unwrap_or(wall) * per_ray,
+            wall_ns_per_ray: wall * per_ray,
             hit_fraction: hits as f64 / rays.max(1) as f64,
         };
         progress(&row);
         rows.push(row);
     }
-    rows
+    Ok(rows)
 }
 
-/// Traces rays from a point 3 radii away towards a disk 1.2 radii wide
-/// around the unit sphere's centre; returns (seconds, hits).
-fn trace_rays(scene: &Scene, rays: u64) -> (f64, u64) {
+/// Rays from a point 3 radii away towards a disk 1.2 radii wide around the
+/// unit sphere's centre (made before timing, so only tracing is measured).
+fn probe_rays(count: u64) -> Vec<Ray> {
     let origin = DVec3::new(0.0, 0.0, 3.0);
-    let directions: Vec<DVec3> = (0..rays)
+    (0..count)
         .map(|i| {
             let u = Sampler::new(SamplerKind::Random, i, 0, 7).next_2d();
             let disk = crate::math::warp::square_to_concentric_disk(u) * 1.2;
-            DVec3::new(disk.x, disk.y, 0.0) - origin
+            Ray::new(origin, DVec3::new(disk.x, disk.y, 0.0) - origin)
         })
-        .collect();
-    let start = Instant::now();
-    let hits = directions.iter().filter(|&&d| scene.intersect(&Ray::new(origin, d), f64::INFINITY).is_some()).count();
-    (start.elapsed().as_secs_f64(), hits as u64)
+        .collect()
+}
+
+/// How many of `rays` hit something.
+fn count_hits(scene: &Scene, rays: &[Ray]) -> u64 {
+    rays.iter()
+        .filter(|ray| scene.intersect(ray, f64::INFINITY).is_some())
+        .count() as u64
 }
 
 /// One row of the render-time measurement.
@@ -150,7 +180,15 @@ pub struct RenderRow {
 
 /// Renders `passes` passes at each width (height by the settings' aspect)
 /// with each thread count.
-pub fn measure_render(scene: &Scene, camera: &Camera, settings: &RenderSettings, widths: &[u32], threads: &[usize], passes: u32, mut progress: impl FnMut(&RenderRow)) -> Result<Vec<RenderRow>, BenchError> {
+pub fn measure_render(
+    scene: &Scene,
+    camera: &Camera,
+    settings: &RenderSettings,
+    widths: &[u32],
+    threads: &[usize],
+    passes: u32,
+    mut progress: impl FnMut(&RenderRow),
+) -> Result<Vec<RenderRow>, BenchError> {
     let mut rows = Vec::new();
     for &thread_count in threads {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(thread_count).build()?;
@@ -187,20 +225,45 @@ pub fn measure_render(scene: &Scene, camera: &Camera, settings: &RenderSettings,
     Ok(rows)
 }
 
+/// Largest triangle count in the O(log n) fit of ray cost.
+const FIT_TRIANGLES: usize = 70_000;
+
 /// Least-squares fit of y = a + b·x.
 fn fit_line(points: &[(f64, f64)]) -> (f64, f64) {
     let n = points.len() as f64;
     let (sx, sy) = points.iter().fold((0.0, 0.0), |(sx, sy), &(x, y)| (sx + x, sy + y));
     let (mx, my) = (sx / n, sy / n);
-    let (sxy, sxx) = points.iter().fold((0.0, 0.0), |(a, b), &(x, y)| (a + (x - mx) * (y - my), b + (x - mx) * (x - mx)));
+    let (sxy, sxx) = points.iter().fold((0.0, 0.0), |(a, b), &(x, y)| {
+        (a + (x - mx) * (y - my), b + (x - mx) * (x - mx))
+    });
     let slope = if sxx > 0.0 { sxy / sxx } else { 0.0 };
     (my - slope * mx, slope)
 }
 
 /// Writes `bvh_scaling.csv` and `bvh_build.png`, `ray_cost.png` into `directory`.
 pub fn write_bvh_results(rows: &[BvhRow], machine: &str, directory: &Path) -> Result<(), BenchError> {
-    let mut csv = Csv::new(vec!["triangles", "nodes", "build_seconds", "build_ns_per_n_log2_n", "rays", "ns_per_ray", "hit_fraction"]);
-    csv.comments.push("prism bench --scaling: BVH build (fastest of repeated builds) and single-thread nearest-hit ray cost on UV spheres".into());
+    let mut csv = Csv::new(vec![
+        "triangles",
+        "nodes",
+        "build_seconds",
+        "build_ns_per_n_log2_n",
+        "build_wall_seconds",
+        "rays",
+        "ns_per_ray",
+        "wall_ns_per_ray",
+        "hit_fraction",
+    ]);
+    csv.comments.push(
+        "prism bench --scaling: BVH build (mean of repeated builds) and nearest-hit ray cost on UV spheres, one thread".into(),
+    );
+    csv.comments.push(format!(
+        "build_seconds and ns_per_ray are thread CPU time ({}); the wall_ columns include time lost to other load",
+        if super::thread_cpu_seconds().is_some() {
+            "from /proc/thread-self/schedstat"
+        } else {
+            "unavailable here: wall time"
+        }
+    ));
     csv.comments.push(machine.to_string());
     for r in rows {
         let n = r.triangles as f64;
@@ -209,8 +272,10 @@ pub fn write_bvh_results(rows: &[BvhRow], machine: &str, directory: &Path) -> Re
             r.nodes.to_string(),
             format_number(r.build_seconds),
             format_number(r.build_seconds * 1e9 / (n * n.log2().max(1.0))),
+            format_number(r.build_wall_seconds),
             r.rays.to_string(),
             format_number(r.ns_per_ray),
+            format_number(r.wall_ns_per_ray),
             format!("{:.4}", r.hit_fraction),
         ]);
     }
@@ -222,14 +287,17 @@ pub fn write_bvh_results(rows: &[BvhRow], machine: &str, directory: &Path) -> Re
         let c = last.build_seconds / (n * n.log2());
         Series {
             name: "c·n·log2(n)".into(),
-            points: rows.iter().map(|r| (r.triangles as f64, c * r.triangles as f64 * (r.triangles as f64).log2())).collect(),
+            points: rows
+                .iter()
+                .map(|r| (r.triangles as f64, c * r.triangles as f64 * (r.triangles as f64).log2()))
+                .collect(),
             guide: true,
         }
     });
     let mut build = LinePlot {
         title: "BVH build time against triangle count".into(),
         x_label: "triangles".into(),
-        y_label: "build time [s]".into(),
+        y_label: "build time [s], 1 thread, CPU time".into(),
         log_x: true,
         log_y: true,
         series: vec![Series {
@@ -241,12 +309,18 @@ pub fn write_bvh_results(rows: &[BvhRow], machine: &str, directory: &Path) -> Re
     build.series.extend(guide);
     build.write_png(&directory.join("bvh_build.png"))?;
 
-    let log_points: Vec<(f64, f64)> = rows.iter().map(|r| ((r.triangles as f64).log2(), r.ns_per_ray)).collect();
+    // Fit a + b·log2(n) where the tree and triangles still fit in the caches
+    // (≤ 2^16 triangles ≈ 10 MB); beyond, memory latency adds to every node.
+    let log_points: Vec<(f64, f64)> = rows
+        .iter()
+        .filter(|r| r.triangles <= FIT_TRIANGLES)
+        .map(|r| ((r.triangles as f64).log2(), r.ns_per_ray))
+        .collect();
     let (a, b) = fit_line(&log_points);
     let rays = LinePlot {
         title: "Cost per ray against triangle count".into(),
         x_label: "triangles".into(),
-        y_label: "ns per ray (1 thread)".into(),
+        y_label: "ns per ray (1 thread, CPU time)".into(),
         log_x: true,
         log_y: false,
         series: vec![
@@ -256,8 +330,11 @@ pub fn write_bvh_results(rows: &[BvhRow], machine: &str, directory: &Path) -> Re
                 guide: false,
             },
             Series {
-                name: format!("fit {a:.0} + {b:.1}·log2(n) ns"),
-                points: rows.iter().map(|r| (r.triangles as f64, a + b * (r.triangles as f64).log2())).collect(),
+                name: format!("{a:.0} + {b:.1}·log2(n) ns, fit for n ≤ 70k"),
+                points: rows
+                    .iter()
+                    .map(|r| (r.triangles as f64, a + b * (r.triangles as f64).log2()))
+                    .collect(),
                 guide: true,
             },
         ],
@@ -267,8 +344,17 @@ pub fn write_bvh_results(rows: &[BvhRow], machine: &str, directory: &Path) -> Re
 
 /// Writes `render_scaling.csv` and `render_scaling.png` into `directory`.
 pub fn write_render_results(rows: &[RenderRow], scene_name: &str, machine: &str, directory: &Path) -> Result<(), BenchError> {
-    let mut csv = Csv::new(vec!["scene", "width", "height", "threads", "passes", "seconds", "ns_per_sample"]);
-    csv.comments.push("prism bench --scaling: render time of a fixed number of passes against resolution and thread count".into());
+    let mut csv = Csv::new(vec![
+        "scene",
+        "width",
+        "height",
+        "threads",
+        "passes",
+        "seconds",
+        "ns_per_sample",
+    ]);
+    csv.comments
+        .push("prism bench --scaling: render time of a fixed number of passes against resolution and thread count".into());
     csv.comments.push(machine.to_string());
     for r in rows {
         csv.rows.push(vec![
@@ -294,7 +380,11 @@ pub fn write_render_results(rows: &[RenderRow], scene_name: &str, machine: &str,
             .iter()
             .map(|&t| Series {
                 name: format!("{t} thread{}", if t == 1 { "" } else { "s" }),
-                points: rows.iter().filter(|r| r.threads == t).map(|r| ((r.width * r.height) as f64, r.seconds / r.passes.max(1) as f64)).collect(),
+                points: rows
+                    .iter()
+                    .filter(|r| r.threads == t)
+                    .map(|r| ((r.width * r.height) as f64, r.seconds / r.passes.max(1) as f64))
+                    .collect(),
                 guide: false,
             })
             .collect(),

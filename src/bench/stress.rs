@@ -15,10 +15,14 @@
 //!
 //! The scenes: the Cornell box scaled to 10⁻⁴ and to 10⁵ units and moved 10⁵
 //! from the origin; smallpt's room of radius-10⁵ spheres; light grazing a
-//! floor; glass nested in glass with nearly coincident surfaces.
+//! floor; glass nested in glass with nearly coincident surfaces; Bezier
+//! surfaces of revolution (glass and diffuse vases) at unit scale, 10⁻⁴ and
+//! 10⁵ from the origin. Disagreements of the revolution intersector with an
+//! independent reference are counted by `tests/revolution_stress.rs`.
 
 use super::scaling::{mesh_scene, sphere_mesh};
 use super::{BenchError, Csv};
+use crate::camera::Camera;
 use crate::geometry::{Mesh, SurfaceHit, Transform};
 use crate::integrator;
 use crate::math::{Frame as LocalFrame, Ray, warp};
@@ -58,10 +62,37 @@ pub struct StressRow {
 /// The Cornell box (the shipped scene's walls, light, mirror and glass balls)
 /// with every coordinate mapped to `offset + scale · x / 555`.
 pub fn cornell_toml(scale: f64, offset: f64) -> String {
-    let p = |v: [f64; 3]| format!("[{:e}, {:e}, {:e}]", offset + scale * v[0] / 555.0, offset + scale * v[1] / 555.0, offset + scale * v[2] / 555.0);
-    let e = |v: [f64; 3]| format!("[{:e}, {:e}, {:e}]", scale * v[0] / 555.0, scale * v[1] / 555.0, scale * v[2] / 555.0);
-    let quad = |corner, u, v, material: &str| format!("[[objects]]\ntype = \"quad\"\ncorner = {}\nedge_u = {}\nedge_v = {}\nmaterial = \"{material}\"\n", p(corner), e(u), e(v));
-    let sphere = |center, radius: f64, material: &str| format!("[[objects]]\ntype = \"sphere\"\ncenter = {}\nradius = {:e}\nmaterial = \"{material}\"\n", p(center), scale * radius / 555.0);
+    let p = |v: [f64; 3]| {
+        format!(
+            "[{:e}, {:e}, {:e}]",
+            offset + scale * v[0] / 555.0,
+            offset + scale * v[1] / 555.0,
+            offset + scale * v[2] / 555.0
+        )
+    };
+    let e = |v: [f64; 3]| {
+        format!(
+            "[{:e}, {:e}, {:e}]",
+            scale * v[0] / 555.0,
+            scale * v[1] / 555.0,
+            scale * v[2] / 555.0
+        )
+    };
+    let quad = |corner, u, v, material: &str| {
+        format!(
+            "[[objects]]\ntype = \"quad\"\ncorner = {}\nedge_u = {}\nedge_v = {}\nmaterial = \"{material}\"\n",
+            p(corner),
+            e(u),
+            e(v)
+        )
+    };
+    let sphere = |center, radius: f64, material: &str| {
+        format!(
+            "[[objects]]\ntype = \"sphere\"\ncenter = {}\nradius = {:e}\nmaterial = \"{material}\"\n",
+            p(center),
+            scale * radius / 555.0
+        )
+    };
     let mut text = format!(
         "[camera]\nposition = {}\nlook_at = {}\nfov_y_degrees = 39.3\n\n{MATERIALS}",
         p([278.0, 273.0, -800.0]),
@@ -271,6 +302,65 @@ radius = 0.3
 material = "glass"
 "#;
 
+/// Two vases turned from one 5-point Bezier profile (surfaces of revolution,
+/// glass and diffuse) on a floor under a ceiling light, like
+/// `scenes/vase.toml`, with every length scaled by `scale` and the whole
+/// moved by `offset` along each axis.
+pub fn vase_toml(scale: f64, offset: f64) -> String {
+    let p = |v: [f64; 3]| {
+        format!(
+            "[{:e}, {:e}, {:e}]",
+            offset + scale * v[0],
+            offset + scale * v[1],
+            offset + scale * v[2]
+        )
+    };
+    let e = |v: [f64; 3]| format!("[{:e}, {:e}, {:e}]", scale * v[0], scale * v[1], scale * v[2]);
+    let quad = |corner, u, v, material: &str| {
+        format!(
+            "[[objects]]\ntype = \"quad\"\ncorner = {}\nedge_u = {}\nedge_v = {}\nmaterial = \"{material}\"\n",
+            p(corner),
+            e(u),
+            e(v)
+        )
+    };
+    let vase = |x: f64, material: &str| {
+        format!(
+            "[[objects]]\ntype = \"revolution\"\nprofile = [[0.0, 0.0], [7.0, 0.4], [0.0, 5.0], [0.2, 5.5], [2.6, 7.5]]\nmaterial = \"{material}\"\ntransform = {{ translate = {}, scale = {scale:e} }}\n",
+            p([x, 0.0, 0.0])
+        )
+    };
+    let mut text = format!(
+        "[camera]\nposition = {}\nlook_at = {}\nfov_y_degrees = 38\n\n{VASE_MATERIALS}",
+        p([0.0, 6.0, 24.0]),
+        p([0.0, 3.5, 0.0])
+    );
+    for object in [
+        quad([-20.0, 0.0, -20.0], [0.0, 0.0, 45.0], [40.0, 0.0, 0.0], "white"),
+        quad([-4.0, 16.0, -4.0], [8.0, 0.0, 0.0], [0.0, 0.0, 8.0], "light"),
+        vase(-3.8, "glass"),
+        vase(3.8, "terracotta"),
+    ] {
+        text.push('\n');
+        text.push_str(&object);
+    }
+    text
+}
+
+const VASE_MATERIALS: &str = r#"[materials.white]
+type = "diffuse"
+albedo = [0.75, 0.75, 0.75]
+[materials.glass]
+type = "glass"
+ior = 1.5
+[materials.terracotta]
+type = "diffuse"
+albedo = [0.7, 0.33, 0.18]
+[materials.light]
+type = "emissive"
+radiance = [12, 12, 12]
+"#;
+
 /// The extreme scenes, by name, as scene-file text.
 pub fn stress_scenes() -> Vec<(&'static str, String)> {
     vec![
@@ -280,6 +370,9 @@ pub fn stress_scenes() -> Vec<(&'static str, String)> {
         ("smallpt-1e5-radius-walls", SMALLPT.to_string()),
         ("grazing-light", GRAZING.to_string()),
         ("nested-glass", NESTED_GLASS.to_string()),
+        ("vase-revolution", vase_toml(1.0, 0.0)),
+        ("vase-revolution-tiny-1e-4", vase_toml(1e-4 / 16.0, 0.0)),
+        ("vase-revolution-far-1e5-from-origin", vase_toml(1.0, 1e5)),
     ]
 }
 
@@ -305,23 +398,34 @@ pub fn rejected_samples(loaded: &LoadedScene, kind: IntegratorKind, options: &St
             return None;
         }
     }
-    Some((options.passes as u64 * settings.pixel_count() as u64, integrator.rejected_samples()))
+    Some((
+        options.passes as u64 * settings.pixel_count() as u64,
+        integrator.rejected_samples(),
+    ))
 }
 
-/// Random walks from `origin` (uniform first direction, then cosine-weighted
-/// about either side of each hit's geometric normal, four bounces), each
-/// continuation made by `Ray::spawn`: returns (spawned rays, self-intersections).
-pub fn self_intersections(scene: &Scene, origin: DVec3, rays: u64) -> (u64, u64) {
-    self_intersections_with(scene, origin, rays, |hit, direction| Ray::spawn(hit.point, hit.point_error, hit.geometric_normal, direction))
+/// Random walks from the camera (a primary ray through a uniform point of
+/// the film, then four bounces cosine-weighted about either side of each
+/// hit's geometric normal), each continuation made by `Ray::spawn`: returns
+/// (spawned rays, self-intersections).
+pub fn self_intersections(scene: &Scene, camera: &Camera, rays: u64) -> (u64, u64) {
+    self_intersections_with(scene, camera, rays, |hit, direction| {
+        Ray::spawn(hit.point, hit.point_error, hit.geometric_normal, direction)
+    })
 }
 
 /// [`self_intersections`] with continuation rays made by `spawn(hit, direction)`
 /// (tests use a naive spawn to show the count can fail).
-pub fn self_intersections_with(scene: &Scene, origin: DVec3, rays: u64, spawn: impl Fn(&SurfaceHit, DVec3) -> Ray) -> (u64, u64) {
+pub fn self_intersections_with(
+    scene: &Scene,
+    camera: &Camera,
+    rays: u64,
+    spawn: impl Fn(&SurfaceHit, DVec3) -> Ray,
+) -> (u64, u64) {
     let (mut spawned, mut self_hits) = (0, 0);
     for i in 0..rays {
         let mut sampler = Sampler::new(SamplerKind::Random, i, 0, 11);
-        let mut ray = Ray::new(origin, warp::square_to_uniform_sphere(sampler.next_2d()));
+        let mut ray = camera.generate_ray(sampler.next_2d(), 1.0, sampler.next_2d());
         let Some(mut hit) = scene.intersect(&ray, f64::INFINITY) else {
             continue;
         };
@@ -413,7 +517,11 @@ fn entry_targets(mesh: &Mesh) -> Vec<(DVec3, DVec3)> {
         }
     }
     // HashMap order is random: sort so runs are reproducible.
-    targets.sort_by(|x, y| x.0.to_array().partial_cmp(&y.0.to_array()).unwrap_or(std::cmp::Ordering::Equal));
+    targets.sort_by(|x, y| {
+        x.0.to_array()
+            .partial_cmp(&y.0.to_array())
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
     targets
 }
 
@@ -458,7 +566,7 @@ pub fn run(options: &StressOptions, mut progress: impl FnMut(&StressRow)) -> Res
                 push(row, &mut rows);
             }
         }
-        let (spawned, self_hits) = self_intersections(&loaded.scene, loaded.camera.position, options.rays);
+        let (spawned, self_hits) = self_intersections(&loaded.scene, &loaded.camera, options.rays);
         push(
             StressRow {
                 scene: name.into(),
@@ -491,10 +599,16 @@ pub fn write_results(rows: &[StressRow], options: &StressOptions, machine: &str,
         "prism bench --stress: {}x{} pixels, {} passes per integrator, {} probe rays per scene or mesh",
         options.width, options.height, options.passes, options.rays
     ));
-    csv.comments.push("Bezier intersection disagreements: not measured (no Bezier revolution shape in this build)".into());
+    csv.comments
+        .push("Bezier intersection disagreements: not measured (no Bezier revolution shape in this build)".into());
     csv.comments.push(machine.to_string());
     for r in rows {
-        csv.rows.push(vec![r.scene.clone(), r.check.clone(), r.tested.to_string(), r.failures.to_string()]);
+        csv.rows.push(vec![
+            r.scene.clone(),
+            r.check.clone(),
+            r.tested.to_string(),
+            r.failures.to_string(),
+        ]);
     }
     csv.write(path)
 }

@@ -38,7 +38,11 @@ impl AxisBox {
         // Snap the coordinate of the face that was hit onto the face plane.
         let center = self.bounds.centroid();
         let positive = point[axis] > center[axis];
-        point[axis] = if positive { self.bounds.max[axis] } else { self.bounds.min[axis] };
+        point[axis] = if positive {
+            self.bounds.max[axis]
+        } else {
+            self.bounds.min[axis]
+        };
         let mut normal = DVec3::ZERO;
         normal[axis] = if positive { 1.0 } else { -1.0 };
         let mut point_error = gamma(3) * (ray.origin.abs() + (t * ray.direction).abs());
@@ -78,7 +82,11 @@ impl AxisBox {
         let positive = face % 2 == 1;
         let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
         let mut point = DVec3::ZERO;
-        point[axis] = if positive { self.bounds.max[axis] } else { self.bounds.min[axis] };
+        point[axis] = if positive {
+            self.bounds.max[axis]
+        } else {
+            self.bounds.min[axis]
+        };
         point[a] = self.bounds.min[a] + reused * d[a];
         point[b] = self.bounds.min[b] + u.y * d[b];
         let mut normal = DVec3::ZERO;

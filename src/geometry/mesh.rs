@@ -40,10 +40,15 @@ impl Mesh {
             let has_normals = m.normals.len() == m.positions.len();
             let has_uvs = m.texcoords.len() / 2 == vertex_count;
             if has_normals {
-                mesh.normals.extend(m.normals.chunks_exact(3).map(|n| DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64)));
+                mesh.normals.extend(
+                    m.normals
+                        .chunks_exact(3)
+                        .map(|n| DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64)),
+                );
             }
             if has_uvs {
-                mesh.uvs.extend(m.texcoords.chunks_exact(2).map(|t| DVec2::new(t[0] as f64, t[1] as f64)));
+                mesh.uvs
+                    .extend(m.texcoords.chunks_exact(2).map(|t| DVec2::new(t[0] as f64, t[1] as f64)));
             }
             for face in m.indices.chunks_exact(3) {
                 let f = [face[0] + base, face[1] + base, face[2] + base];

@@ -95,8 +95,14 @@ mod tests {
         let hit = q.intersect(&Ray::new(DVec3::new(1.0, 3.0, 0.5), -DVec3::Y), f64::INFINITY);
         let hit = hit.map(|h| (h.t, h.uv));
         assert!(matches!(hit, Some((t, uv)) if (t - 3.0).abs() < 1e-12 && (uv - DVec2::new(0.5, 0.5)).length() < 1e-12));
-        assert!(q.intersect(&Ray::new(DVec3::new(3.0, 3.0, 0.5), -DVec3::Y), f64::INFINITY).is_none());
-        assert!(q.intersect(&Ray::new(DVec3::new(1.0, 0.0, -1.0), DVec3::Z), f64::INFINITY).is_none());
+        assert!(
+            q.intersect(&Ray::new(DVec3::new(3.0, 3.0, 0.5), -DVec3::Y), f64::INFINITY)
+                .is_none()
+        );
+        assert!(
+            q.intersect(&Ray::new(DVec3::new(1.0, 0.0, -1.0), DVec3::Z), f64::INFINITY)
+                .is_none()
+        );
         assert!((q.area() - 2.0).abs() < 1e-12);
     }
 }

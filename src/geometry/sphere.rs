@@ -14,7 +14,10 @@ pub struct Sphere {
 
 impl Sphere {
     pub fn bounds(&self) -> Aabb {
-        Aabb::new(self.center - DVec3::splat(self.radius), self.center + DVec3::splat(self.radius))
+        Aabb::new(
+            self.center - DVec3::splat(self.radius),
+            self.center + DVec3::splat(self.radius),
+        )
     }
 
     pub fn area(&self) -> f64 {
@@ -94,7 +97,10 @@ mod tests {
 
     #[test]
     fn hits_at_known_distances_from_outside_and_inside() {
-        let s = Sphere { center: DVec3::new(0.0, 0.0, 5.0), radius: 1.0 };
+        let s = Sphere {
+            center: DVec3::new(0.0, 0.0, 5.0),
+            radius: 1.0,
+        };
         let outside = s.intersect(&Ray::new(DVec3::ZERO, DVec3::Z), f64::INFINITY).map(|h| h.t);
         assert!((outside.unwrap_or(0.0) - 4.0).abs() < 1e-12);
         let inside = s.intersect(&Ray::new(s.center, DVec3::X), f64::INFINITY);
@@ -107,7 +113,10 @@ mod tests {
     #[test]
     fn huge_walls_are_hit_where_they_are() {
         // smallpt's left wall: centre (1e5 + 1, 40.8, 81.6), radius 1e5, surface at x = 1.
-        let wall = Sphere { center: DVec3::new(1e5 + 1.0, 40.8, 81.6), radius: 1e5 };
+        let wall = Sphere {
+            center: DVec3::new(1e5 + 1.0, 40.8, 81.6),
+            radius: 1e5,
+        };
         let ray = Ray::new(DVec3::new(50.0, 40.8, 81.6), -DVec3::X);
         let hit = wall.intersect(&ray, f64::INFINITY).map(|h| (h.t, h.point.x));
         assert!(matches!(hit, Some((t, x)) if (t - 49.0).abs() < 1e-9 && (x - 1.0).abs() < 1e-9));

@@ -56,7 +56,11 @@ impl Triangle {
             let v = permute(v - ray.origin);
             DVec3::new(v.x + shear_x * v.z, v.y + shear_y * v.z, v.z)
         };
-        let p = [transform(self.vertices[0]), transform(self.vertices[1]), transform(self.vertices[2])];
+        let p = [
+            transform(self.vertices[0]),
+            transform(self.vertices[1]),
+            transform(self.vertices[2]),
+        ];
         // Edge functions; exact sign at zero falls back to a tie-break in the
         // same way for both triangles sharing the edge.
         let e0 = p[1].x * p[2].y - p[1].y * p[2].x;

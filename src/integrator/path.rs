@@ -73,7 +73,10 @@ impl PathTracer {
 
             let frame = ShadingFrame::from_normal(hit.shading_normal);
             let wo = frame.to_local(wo_world);
-            let at = ShadingPoint { uv: hit.uv, point: hit.point };
+            let at = ShadingPoint {
+                uv: hit.uv,
+                point: hit.point,
+            };
 
             // Next-event estimation: one light sample, MIS-weighted.
             if light_sampling && !material.is_specular() {

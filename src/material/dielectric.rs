@@ -10,7 +10,11 @@ use glam::DVec3;
 /// `cos_theta_i` (positive on the outside) with relative index `ior` = n_inside / n_outside.
 /// Exact average of the s- and p-polarised terms (pbrt-v4 eq. 9.6).
 pub fn fresnel_dielectric(cos_theta_i: f64, ior: f64) -> f64 {
-    let (cos_i, eta) = if cos_theta_i < 0.0 { (-cos_theta_i, 1.0 / ior) } else { (cos_theta_i, ior) };
+    let (cos_i, eta) = if cos_theta_i < 0.0 {
+        (-cos_theta_i, 1.0 / ior)
+    } else {
+        (cos_theta_i, ior)
+    };
     let cos_i = cos_i.min(1.0);
     let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
     if sin2_t >= 1.0 {

@@ -13,7 +13,11 @@ pub fn eval(albedo: Color, wo: DVec3, wi: DVec3) -> Color {
 }
 
 pub fn pdf(wo: DVec3, wi: DVec3) -> f64 {
-    if wo.z * wi.z <= 0.0 { 0.0 } else { warp::cosine_hemisphere_pdf(wi.z.abs()) }
+    if wo.z * wi.z <= 0.0 {
+        0.0
+    } else {
+        warp::cosine_hemisphere_pdf(wi.z.abs())
+    }
 }
 
 pub fn sample(albedo: Color, wo: DVec3, u: DVec2) -> Option<BsdfSample> {

@@ -71,7 +71,11 @@ pub fn sample(tint: Color, roughness: f64, wo: DVec3, u: DVec2) -> Option<BsdfSa
     // Stretch wo to the hemisphere configuration.
     let vh = DVec3::new(a * wo_up.x, a * wo_up.y, wo_up.z).normalize();
     let length_sq = vh.x * vh.x + vh.y * vh.y;
-    let t1 = if length_sq > 0.0 { DVec3::new(-vh.y, vh.x, 0.0) / length_sq.sqrt() } else { DVec3::X };
+    let t1 = if length_sq > 0.0 {
+        DVec3::new(-vh.y, vh.x, 0.0) / length_sq.sqrt()
+    } else {
+        DVec3::X
+    };
     let t2 = vh.cross(t1);
     // Uniform disk point, warped towards the visible half.
     let r = u.x.sqrt();
@@ -122,7 +126,11 @@ mod tests {
     /// accurate to about 1e-3 here.
     #[test]
     fn pdf_integrates_to_the_probability_of_a_sample() {
-        for (roughness, wo) in [(0.5, DVec3::new(0.5, 0.0, 0.866)), (0.2, DVec3::new(0.0, 0.3, 0.95)), (0.8, DVec3::new(0.9, 0.0, 0.3))] {
+        for (roughness, wo) in [
+            (0.5, DVec3::new(0.5, 0.0, 0.866)),
+            (0.2, DVec3::new(0.0, 0.3, 0.95)),
+            (0.8, DVec3::new(0.9, 0.0, 0.3)),
+        ] {
             let wo = wo.normalize();
             let n = 400;
             let mut total = 0.0;
@@ -139,7 +147,10 @@ mod tests {
                 }
             }
             let fraction = accepted as f64 / (n * n) as f64;
-            assert!((total - fraction).abs() < 0.005 && total <= 1.0 + 1e-3, "α {roughness}: ∫pdf {total}, sampled {fraction}");
+            assert!(
+                (total - fraction).abs() < 0.005 && total <= 1.0 + 1e-3,
+                "α {roughness}: ∫pdf {total}, sampled {fraction}"
+            );
         }
     }
 }

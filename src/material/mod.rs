@@ -45,13 +45,26 @@ pub struct BsdfSample {
 
 #[derive(Clone, Debug)]
 pub enum Material {
-    Diffuse { albedo: Texture },
-    Mirror { tint: Texture },
-    Glass { ior: f64, tint: Color },
-    Glossy { tint: Texture, roughness: f64 },
+    Diffuse {
+        albedo: Texture,
+    },
+    Mirror {
+        tint: Texture,
+    },
+    Glass {
+        ior: f64,
+        tint: Color,
+    },
+    Glossy {
+        tint: Texture,
+        roughness: f64,
+    },
     /// A light: emits `radiance` from its front (outward normal) side, or both
     /// sides when `two_sided`; reflects nothing.
-    Emissive { radiance: Color, two_sided: bool },
+    Emissive {
+        radiance: Color,
+        two_sided: bool,
+    },
 }
 
 impl Material {

@@ -46,11 +46,7 @@ impl Aabb {
     }
 
     pub fn extent(&self) -> DVec3 {
-        if self.is_empty() {
-            DVec3::ZERO
-        } else {
-            self.max - self.min
-        }
+        if self.is_empty() { DVec3::ZERO } else { self.max - self.min }
     }
 
     pub fn centroid(&self) -> DVec3 {

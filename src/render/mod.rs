@@ -26,7 +26,9 @@ impl Progress {
     /// Fraction done, by passes or by time, whichever is further along.
     pub fn fraction(&self) -> Option<f64> {
         let by_passes = self.target_passes.map(|t| self.passes as f64 / t.max(1) as f64);
-        let by_time = self.time_limit.map(|t| self.elapsed.as_secs_f64() / t.as_secs_f64().max(1e-9));
+        let by_time = self
+            .time_limit
+            .map(|t| self.elapsed.as_secs_f64() / t.as_secs_f64().max(1e-9));
         match (by_passes, by_time) {
             (Some(a), Some(b)) => Some(a.max(b).min(1.0)),
             (a, b) => a.or(b).map(|f| f.min(1.0)),
@@ -69,7 +71,12 @@ pub fn render_progressive(
 }
 
 /// Renders to completion with `threads` worker threads (all cores if `None`).
-pub fn render_with_threads(scene: &Scene, camera: &Camera, settings: &RenderSettings, threads: Option<usize>) -> Result<Box<dyn Integrator>, rayon::ThreadPoolBuildError> {
+pub fn render_with_threads(
+    scene: &Scene,
+    camera: &Camera,
+    settings: &RenderSettings,
+    threads: Option<usize>,
+) -> Result<Box<dyn Integrator>, rayon::ThreadPoolBuildError> {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0)).build()?;
     let cancel = AtomicBool::new(false);
     Ok(pool.install(|| render_progressive(scene, camera, settings, &cancel, |_, _| {})))

@@ -43,7 +43,12 @@ pub fn add_samples(film: &mut Film, cancel: &AtomicBool, sample: impl Fn(u32, u3
 
 /// Adds one sample to each pixel that adaptive sampling with `threshold`
 /// has not stopped (see [`is_converged`]); `None` samples every pixel.
-pub fn add_samples_adaptive(film: &mut Film, cancel: &AtomicBool, threshold: Option<f64>, sample: impl Fn(u32, u32) -> Color + Sync) -> bool {
+pub fn add_samples_adaptive(
+    film: &mut Film,
+    cancel: &AtomicBool,
+    threshold: Option<f64>,
+    sample: impl Fn(u32, u32) -> Color + Sync,
+) -> bool {
     match threshold {
         Some(threshold) => add_samples_where(film, cancel, |pixel| !is_converged(pixel, threshold), sample),
         None => add_samples(film, cancel, sample),
@@ -106,7 +111,11 @@ mod tests {
         let threshold = 0.1;
         for pass in 0..200u32 {
             add_samples_adaptive(&mut film, &cancel, Some(threshold), |x, _| {
-                if x == 0 { Color::splat(0.5) } else { Color::splat(2.0 * (pass % 2) as f64) }
+                if x == 0 {
+                    Color::splat(0.5)
+                } else {
+                    Color::splat(2.0 * (pass % 2) as f64)
+                }
             });
         }
         assert_eq!(film.pixels[0].count, ADAPTIVE_MIN_SAMPLES);
@@ -135,6 +144,10 @@ mod tests {
         let two = render_with_threads(&loaded.scene, &loaded.camera, &settings, Some(2)).expect("pool");
         assert_eq!(one.frame(), two.frame());
         // And some pixels did stop (else this would test nothing adaptive).
-        assert!(one.status().contains("active") && !one.status().starts_with("adaptive: 100%"), "{}", one.status());
+        assert!(
+            one.status().contains("active") && !one.status().starts_with("adaptive: 100%"),
+            "{}",
+            one.status()
+        );
     }
 }

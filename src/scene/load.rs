@@ -30,7 +30,8 @@ pub struct LoadedScene {
 
 /// Reads and builds a scene file; relative paths inside resolve against its folder.
 pub fn load_scene_file(path: &Path) -> Result<LoadedScene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError::new(path, None, None, format!("cannot read scene file: {e}")))?;
+    let text =
+        std::fs::read_to_string(path).map_err(|e| SceneError::new(path, None, None, format!("cannot read scene file: {e}")))?;
     let base = path.parent().unwrap_or(Path::new("."));
     let mut loaded = load_scene_str(&text, path, base)?;
     loaded.path = Some(path.to_path_buf());
@@ -44,10 +45,16 @@ pub fn load_scene_str(text: &str, file: &Path, base: &Path) -> Result<LoadedScen
         let line = e.span().map(|span| {
             // Tagged tables report errors at their start; point at the
             // offending key itself when the message names it.
-            let key = message.strip_prefix("unknown field `").and_then(|rest| rest.split('`').next());
+            let key = message
+                .strip_prefix("unknown field `")
+                .and_then(|rest| rest.split('`').next());
             let start = span.start.min(text.len());
-            let next_header = text[start + 1.min(text.len() - start)..].find("\n[").map_or(text.len(), |i| start + 1 + i);
-            let offset = key.and_then(|k| find_key(&text[start..next_header.max(start)], k)).unwrap_or(0);
+            let next_header = text[start + 1.min(text.len() - start)..]
+                .find("\n[")
+                .map_or(text.len(), |i| start + 1 + i);
+            let offset = key
+                .and_then(|k| find_key(&text[start..next_header.max(start)], k))
+                .unwrap_or(0);
             line_of(text, start + offset)
         });
         SceneError::new(file, line, None, message)
@@ -74,7 +81,11 @@ impl Builder<'_> {
             let key_offset = find_key(&self.text[start..end], field).unwrap_or(0);
             line_of(self.text, start + key_offset)
         });
-        let full = if path.is_empty() { field.to_string() } else { format!("{path}.{field}") };
+        let full = if path.is_empty() {
+            field.to_string()
+        } else {
+            format!("{path}.{field}")
+        };
         SceneError::new(self.file, line, Some(full), message)
     }
 
@@ -119,7 +130,12 @@ impl Builder<'_> {
             let object = spanned.get_ref();
             let material = *material_index.get(object.material()).ok_or_else(|| {
                 let known: Vec<&str> = material_index.keys().copied().collect();
-                self.error(span.clone(), &path, "material", format!("unknown material \"{}\" (defined: {})", object.material(), known.join(", ")))
+                self.error(
+                    span.clone(),
+                    &path,
+                    "material",
+                    format!("unknown material \"{}\" (defined: {})", object.material(), known.join(", ")),
+                )
             })?;
             self.object(&span, &path, object, material, &mut primitives, &mut meshes)?;
         }
@@ -293,9 +309,13 @@ impl Builder<'_> {
                 if lo.cmpge(hi).any() {
                     return Err(self.error(span.clone(), path, "max", "must exceed min on every axis"));
                 }
-                push(Shape::AxisBox(AxisBox { bounds: Aabb::new(lo, hi) }));
+                push(Shape::AxisBox(AxisBox {
+                    bounds: Aabb::new(lo, hi),
+                }));
             }
-            ObjectDescription::Quad { corner, edge_u, edge_v, .. } => {
+            ObjectDescription::Quad {
+                corner, edge_u, edge_v, ..
+            } => {
                 self.finite(span, path, "corner", corner)?;
                 self.finite(span, path, "edge_u", edge_u)?;
                 self.finite(span, path, "edge_v", edge_v)?;
@@ -322,7 +342,12 @@ impl Builder<'_> {
                 let transform = self.transform(span, path, transform)?;
                 let mesh_path = self.base.join(file);
                 if !mesh_path.is_file() {
-                    return Err(self.error(span.clone(), path, "file", format!("mesh file not found: {}", mesh_path.display())));
+                    return Err(self.error(
+                        span.clone(),
+                        path,
+                        "file",
+                        format!("mesh file not found: {}", mesh_path.display()),
+                    ));
                 }
                 let mesh = Mesh::load_obj(&mesh_path, &transform)
                     .map_err(|e| self.error(span.clone(), path, "file", format!("{}: {e}", mesh_path.display())))?;
@@ -341,7 +366,10 @@ impl Builder<'_> {
             } => {
                 let segments: Vec<Vec<DVec2>> = match (profile, segments) {
                     (Some(points), None) => vec![points.iter().map(|p| DVec2::from_array(*p)).collect()],
-                    (None, Some(chain)) => chain.iter().map(|s| s.iter().map(|p| DVec2::from_array(*p)).collect()).collect(),
+                    (None, Some(chain)) => chain
+                        .iter()
+                        .map(|s| s.iter().map(|p| DVec2::from_array(*p)).collect())
+                        .collect(),
                     _ => return Err(self.error(span.clone(), path, "profile", "give exactly one of `profile` or `segments`")),
                 };
                 let field = if profile.is_some() { "profile" } else { "segments" };

@@ -11,6 +11,9 @@
 
 mod app;
 mod camera_input;
+mod event_log;
+mod files;
+mod image_view;
 mod loader;
 mod panels;
 mod texture;
@@ -27,20 +30,31 @@ pub struct ViewerStart {
     pub scene: Option<PathBuf>,
     /// Render worker threads (0 = all cores).
     pub render_threads: usize,
+    /// Nice value of the render workers (Linux), so the UI keeps a core when it needs one.
+    pub render_niceness: u8,
     /// Initial resolution scale (1 = the scene's own width and height).
     pub resolution_scale: f32,
     /// Print timestamped events (first image, restart latency, UI frame
-    /// rate) to stderr and repaint continuously so the frame rate can be measured.
+    /// rate) to stderr: `PRISM_VIEWER_LOG=1`.
     pub log: bool,
+    /// Repaint continuously, so the logged frame rate is what the UI can
+    /// sustain while rendering: `PRISM_VIEWER_LOG=2`.
+    pub continuous_repaint: bool,
 }
 
 impl Default for ViewerStart {
     fn default() -> Self {
+        let log_level: u32 = std::env::var("PRISM_VIEWER_LOG")
+            .ok()
+            .and_then(|v| v.trim().parse().ok())
+            .unwrap_or(0);
         Self {
             scene: None,
             render_threads: 2,
+            render_niceness: 10,
             resolution_scale: 1.0,
-            log: std::env::var_os("PRISM_VIEWER_LOG").is_some_and(|v| !v.is_empty() && v != "0"),
+            log: log_level >= 1,
+            continuous_repaint: log_level >= 2,
         }
     }
 }

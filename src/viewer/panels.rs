@@ -172,15 +172,26 @@ fn ui_display(app: &mut ViewerApp, ui: &mut Ui) {
                 ui.selectable_value(&mut app.tone_map, tone_map, format!("{tone_map:?}"));
             }
         });
+    let has_radii = app.display.frame.as_ref().is_some_and(|f| f.radii.is_some());
     ui.horizontal(|ui| {
         ui.radio_value(&mut app.view, ViewKind::Image, "Image");
-        ui.radio_value(&mut app.view, ViewKind::Noise, "Noise heatmap");
-    });
-    if app.view == ViewKind::Noise {
-        ui.small("Relative standard error per pixel: blue 0.1 % → red → white ≥ 100 %.");
-        if app.settings.integrator == IntegratorKind::Sppm {
-            ui.small("SPPM radii view: not available (the SPPM integrator publishes no radii).");
+        ui.radio_value(&mut app.view, ViewKind::Noise, "Noise");
+        let radii = ui.add_enabled(has_radii, egui::RadioButton::new(app.view == ViewKind::Radii, "SPPM radii"));
+        if radii.clicked() {
+            app.view = ViewKind::Radii;
         }
+    });
+    match app.view {
+        ViewKind::Noise => {
+            ui.small("Relative standard error per pixel: dark blue 0.1 %, then red, yellow, white 100 % or more.");
+        }
+        ViewKind::Radii if has_radii => {
+            ui.small("Gather radius per pixel, log scale: dark = smallest, white = largest; black = none yet.");
+        }
+        ViewKind::Radii => {
+            ui.small("No radii in this frame (not SPPM, or a preview): showing the noise view.");
+        }
+        ViewKind::Image => {}
     }
 }
 
@@ -195,6 +206,11 @@ fn ui_snapshot(app: &mut ViewerApp, ui: &mut Ui) {
                 .hint_text("path.png / .bmp / .exr"),
         );
         field.widget_info(|| egui::WidgetInfo::labeled(egui::Role::TextInput, true, "Snapshot path"));
+        if app.save.dialog_unavailable {
+            // The dialog could not open: the path field takes over.
+            field.request_focus();
+            app.save.dialog_unavailable = false;
+        }
         if ui.button("Save").clicked() {
             let path = std::path::PathBuf::from(app.save.path_text.trim());
             app.save_snapshot(&path);

@@ -77,6 +77,27 @@ pub fn noise_heatmap(frame: &Frame) -> ColorImage {
     ColorImage::new([frame.width as usize, frame.height as usize], pixels)
 }
 
+/// A heatmap of SPPM's per-pixel gather radii on a log scale from the
+/// smallest (dark) to the largest (white) current radius; pixels without a
+/// radius yet are black.
+pub fn radii_heatmap(width: u32, height: u32, radii: &[f32]) -> ColorImage {
+    let positive = radii.iter().copied().filter(|r| *r > 0.0 && r.is_finite());
+    let (low, high) = positive.fold((f32::INFINITY, 0.0f32), |(lo, hi), r| (lo.min(r), hi.max(r)));
+    let (low, high) = ((low as f64).ln(), (high as f64).ln());
+    let span = (high - low).max(1e-9);
+    let pixels = radii
+        .iter()
+        .map(|&r| {
+            if r > 0.0 && r.is_finite() {
+                heat_color(0.1 + 0.9 * ((r as f64).ln() - low) / span)
+            } else {
+                Color32::BLACK
+            }
+        })
+        .collect();
+    ColorImage::new([width as usize, height as usize], pixels)
+}
+
 /// A perceptually ordered ramp: black → blue → red → yellow → white.
 fn heat_color(t: f64) -> Color32 {
     const STOPS: [[f64; 3]; 5] = [

@@ -8,8 +8,9 @@
 //!    flux to every visible point whose sphere contains it ([`photon`]);
 //! 4. per-pixel progressive radius reduction ([`statistics`]).
 //!
-//! The image is τ / (π R² · photons emitted) plus the emission each camera
-//! path saw along its specular chain, averaged over iterations. All light
+//! The image is τ / (π R² · photons emitted) plus the emission camera paths
+//! saw along their specular chains, averaged over iterations (with a few
+//! extra camera paths per iteration for that cheap term). All light
 //! reflected diffusely (direct lighting included) comes from photons: the
 //! classic form, consistent as R → 0. A non-black background is seen
 //! directly and through glass, but emits no photons, so it lights nothing.
@@ -42,6 +43,16 @@ use visible_point::{VisiblePoint, trace_camera_path};
 /// the camera paths of the same index and iteration.
 const PHOTON_SEED: u64 = 0x5eed_0f94_0705_eed1;
 
+/// Camera paths per pixel and iteration for the emitted term (lights seen
+/// directly or through glass and mirrors). Only the first leaves a visible
+/// point; the others are cheap (they stop at the first diffuse surface) and
+/// cut the noise of small, bright light images, which would otherwise get
+/// only one sample per photon pass.
+const EMISSION_SAMPLES: u32 = 4;
+
+/// Mixed into the seed of the extra emission paths' streams.
+const EMISSION_SEED: u64 = 0xe4e5_5101_7a11_c0de;
+
 /// Automatic initial radius, in pixel footprints at the visible point: about
 /// π·1.5² ≈ 7 pixels' worth of surface, enough photons per gather at the
 /// default photon count to keep the first iterations from being blotchy.
@@ -52,6 +63,13 @@ const INITIAL_RADIUS_PIXELS: f64 = 1.5;
 /// happens to lie within the radius (the far side of a thin wall, the other
 /// wall at a corner). Smooth surfaces agree ever better as the radius shrinks.
 const NORMAL_AGREEMENT: f64 = 0.5;
+
+/// The scale photon tallies count in: the lights' total power, about one
+/// photon's flux, so fixed-point sums keep the same relative precision in
+/// any scene's units.
+fn flux_unit(scene: &Scene) -> f64 {
+    scene.lights.total_power.max(f64::MIN_POSITIVE)
+}
 
 /// The radius a pixel starts with: the absolute setting, or a few pixel
 /// footprints at the distance its first camera path travelled.
@@ -155,16 +173,30 @@ impl SppmIntegrator {
                 let mut sampler = Sampler::new(kind, index as u64, iteration, seed);
                 let ray = camera_ray(camera, size, x, y, &mut sampler);
                 let path = trace_camera_path(scene, ray, &mut sampler, max_depth);
-                if path.emitted.is_finite() {
-                    pixel.emitted_sum += path.emitted;
+                // The emitted term: this path and a few more, from their own
+                // Sobol' stream so each stream stays stratified over iterations.
+                let mut emitted = path.emitted;
+                for extra in 0..EMISSION_SAMPLES - 1 {
+                    let mut sampler = Sampler::new(
+                        kind,
+                        index as u64,
+                        iteration * (EMISSION_SAMPLES - 1) + extra,
+                        seed ^ EMISSION_SEED,
+                    );
+                    let ray = camera_ray(camera, size, x, y, &mut sampler);
+                    emitted += trace_camera_path(scene, ray, &mut sampler, max_depth).emitted;
+                }
+                let emitted = emitted / EMISSION_SAMPLES as f64;
+                if emitted.is_finite() {
+                    pixel.emitted_sum += emitted;
                 } else {
                     rejected.fetch_add(1, Ordering::Relaxed);
                 }
                 let visible_point = path.visible_point.filter(|vp| vp.throughput.is_finite());
-                if let Some(vp) = &visible_point {
-                    if pixel.radius == 0.0 {
-                        pixel.radius = initial_radius.at_distance(vp.path_length);
-                    }
+                if pixel.radius == 0.0 {
+                    pixel.radius = visible_point
+                        .as_ref()
+                        .map_or(0.0, |vp| initial_radius.at_distance(vp.path_length));
                 }
                 visible_point
             })
@@ -178,6 +210,7 @@ impl SppmIntegrator {
     fn photon_pass(&self, scene: &Scene, visible: &[Option<VisiblePoint>], grid: &VisiblePointGrid, cancel: &AtomicBool) -> bool {
         let (kind, iteration, max_depth) = (self.sampler, self.iterations, self.max_depth);
         let seed = self.seed ^ PHOTON_SEED;
+        let inverse_unit = 1.0 / flux_unit(scene);
         (0..self.parameters.photons_per_iteration)
             .into_par_iter()
             .with_min_len(64)
@@ -203,7 +236,7 @@ impl SppmIntegrator {
                         }
                         let material = &scene.materials[vp.material as usize];
                         let f = material.eval(vp.wo, vp.frame.to_local(towards_light), &vp.at);
-                        self.tallies[pixel as usize].add(flux * f);
+                        self.tallies[pixel as usize].add(flux * f, inverse_unit);
                     }
                 });
             });
@@ -211,15 +244,16 @@ impl SppmIntegrator {
     }
 
     /// Step 4: folds each pixel's tally into its statistics.
-    fn update_statistics(&mut self, visible: &[Option<VisiblePoint>]) {
+    fn update_statistics(&mut self, scene: &Scene, visible: &[Option<VisiblePoint>]) {
         let alpha = self.parameters.alpha;
+        let unit = flux_unit(scene);
         let rejected = AtomicU64::new(0);
         self.pixels
             .par_iter_mut()
             .zip(self.tallies.par_iter_mut())
             .zip(visible.par_iter())
             .for_each(|((pixel, tally), vp)| {
-                let (flux, count) = tally.take();
+                let (flux, count) = tally.take(unit);
                 let Some(vp) = vp else { return };
                 let flux = vp.throughput * flux;
                 if flux.is_finite() {
@@ -233,7 +267,7 @@ impl SppmIntegrator {
 
     fn clear_tallies(&mut self) {
         self.tallies.par_iter_mut().for_each(|t| {
-            t.take();
+            t.take(1.0);
         });
     }
 }
@@ -257,7 +291,7 @@ impl Integrator for SppmIntegrator {
             return false;
         }
         self.photon_time += photons_start.elapsed();
-        self.update_statistics(&visible);
+        self.update_statistics(scene, &visible);
         self.iterations += 1;
         self.total_time += start.elapsed();
         true

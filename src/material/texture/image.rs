@@ -19,15 +19,9 @@ use std::sync::Arc;
 #[derive(Debug, thiserror::Error)]
 pub enum ImageError {
     #[error("cannot read image {}: {source}", path.display())]
-    Read {
-        path: PathBuf,
-        source: std::io::Error,
-    },
+    Read { path: PathBuf, source: std::io::Error },
     #[error("cannot decode image {}: {source}", path.display())]
-    Decode {
-        path: PathBuf,
-        source: image::ImageError,
-    },
+    Decode { path: PathBuf, source: image::ImageError },
     #[error("image {} has no pixels", path.display())]
     Empty { path: PathBuf },
 }
@@ -145,14 +139,8 @@ impl Image {
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
         let (x0, y0) = (x0 as i64, y0 as i64);
-        let (xa, xb) = (
-            wrap[0].index(x0, self.width),
-            wrap[0].index(x0 + 1, self.width),
-        );
-        let (ya, yb) = (
-            wrap[1].index(y0, self.height),
-            wrap[1].index(y0 + 1, self.height),
-        );
+        let (xa, xb) = (wrap[0].index(x0, self.width), wrap[0].index(x0 + 1, self.width));
+        let (ya, yb) = (wrap[1].index(y0, self.height), wrap[1].index(y0 + 1, self.height));
         let top = self.texel(xa, ya) * (1.0 - fx) + self.texel(xb, ya) * fx;
         let bottom = self.texel(xa, yb) * (1.0 - fx) + self.texel(xb, yb) * fx;
         top * (1.0 - fy) + bottom * fy
@@ -161,34 +149,17 @@ impl Image {
 
 /// Linear texels of a decoded file: sRGB-decoded unless the file stores floats.
 fn linear_texels(decoded: DynamicImage) -> Vec<[f32; 3]> {
-    let is_float = matches!(
-        decoded,
-        DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_)
-    );
+    let is_float = matches!(decoded, DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_));
     if is_float {
-        decoded
-            .to_rgb32f()
-            .pixels()
-            .map(|p| clamp_texel(p.0))
-            .collect()
+        decoded.to_rgb32f().pixels().map(|p| clamp_texel(p.0)).collect()
     } else if decoded.color().bytes_per_pixel() / decoded.color().channel_count() > 1 {
         // 16 bits per channel: decode each value; a table would have 65536 entries.
         let decode = |v: u16| srgb_decode(v as f64 / 65535.0) as f32;
-        decoded
-            .to_rgb16()
-            .pixels()
-            .map(|p| p.0.map(decode))
-            .collect()
+        decoded.to_rgb16().pixels().map(|p| p.0.map(decode)).collect()
     } else {
         // 8 bits per channel: 256 possible values, decoded once each.
-        let table: Vec<f32> = (0..=255u8)
-            .map(|v| srgb_decode(v as f64 / 255.0) as f32)
-            .collect();
-        decoded
-            .to_rgb8()
-            .pixels()
-            .map(|p| p.0.map(|v| table[v as usize]))
-            .collect()
+        let table: Vec<f32> = (0..=255u8).map(|v| srgb_decode(v as f64 / 255.0) as f32).collect();
+        decoded.to_rgb8().pixels().map(|p| p.0.map(|v| table[v as usize])).collect()
     }
 }
 
@@ -260,15 +231,9 @@ mod tests {
         // column's (wrapped) centre.
         let repeat = image.bilinear(DVec2::new(0.0, 0.75), [Wrap::Repeat; 2]);
         assert!((repeat - (Color::X + Color::Y) / 2.0).length() < 1e-12);
-        assert_eq!(
-            image.bilinear(DVec2::new(0.0, 0.75), [Wrap::Clamp; 2]),
-            Color::X
-        );
+        assert_eq!(image.bilinear(DVec2::new(0.0, 0.75), [Wrap::Clamp; 2]), Color::X);
         // One whole period away reads the same texel.
-        assert_eq!(
-            image.bilinear(DVec2::new(2.25, -0.75), [Wrap::Repeat; 2]),
-            Color::Z
-        );
+        assert_eq!(image.bilinear(DVec2::new(2.25, -0.75), [Wrap::Repeat; 2]), Color::Z);
     }
 
     #[test]

@@ -78,11 +78,7 @@ fn direction_of_sphere_uv(uv: DVec2) -> DVec3 {
     let longitude = (uv.x - 0.5) * TAU;
     let polar = uv.y * PI;
     let (sin_polar, cos_polar) = polar.sin_cos();
-    DVec3::new(
-        sin_polar * longitude.sin(),
-        cos_polar,
-        sin_polar * longitude.cos(),
-    )
+    DVec3::new(sin_polar * longitude.sin(), cos_polar, sin_polar * longitude.cos())
 }
 
 #[derive(Clone, Debug)]

@@ -39,11 +39,7 @@ impl Texture {
     pub fn evaluate(&self, at: &ShadingPoint) -> Color {
         match self {
             Texture::Constant(c) => *c,
-            Texture::Image {
-                image,
-                mapping,
-                wrap,
-            } => image.bilinear(mapping.map(at), *wrap),
+            Texture::Image { image, mapping, wrap } => image.bilinear(mapping.map(at), *wrap),
             Texture::Checker { colors, mapping } => procedural::checker(colors, mapping.map(at)),
             Texture::Gradient(gradient) => gradient.evaluate(at.point),
         }

@@ -7,9 +7,7 @@ use glam::{DVec2, DVec3};
 /// coordinates: colour `(⌊u⌋ + ⌊v⌋) mod 2`.
 #[inline]
 pub fn checker(colors: &[Color; 2], uv: DVec2) -> Color {
-    let parity = (uv.x.floor() as i64)
-        .wrapping_add(uv.y.floor() as i64)
-        .rem_euclid(2);
+    let parity = (uv.x.floor() as i64).wrapping_add(uv.y.floor() as i64).rem_euclid(2);
     colors[parity as usize]
 }
 
@@ -28,12 +26,7 @@ impl Gradient {
     /// `None` if the axis is zero or `from == to`.
     pub fn new(colors: [Color; 2], axis: DVec3, from: f64, to: f64) -> Option<Self> {
         let axis = axis.try_normalize()?;
-        (from != to && from.is_finite() && to.is_finite()).then_some(Self {
-            colors,
-            axis,
-            from,
-            to,
-        })
+        (from != to && from.is_finite() && to.is_finite()).then_some(Self { colors, axis, from, to })
     }
 
     #[inline]
@@ -63,9 +56,7 @@ mod tests {
         let g = Gradient::new([Color::X, Color::Z], DVec3::new(0.0, 2.0, 0.0), 1.0, 3.0);
         let g = g.unwrap_or_else(|| panic!("valid gradient"));
         // Linear interpolation of exact binary fractions: exact to 1e-15.
-        assert!(
-            (g.evaluate(DVec3::new(7.0, 1.5, -2.0)) - Color::new(0.75, 0.0, 0.25)).length() < 1e-15
-        );
+        assert!((g.evaluate(DVec3::new(7.0, 1.5, -2.0)) - Color::new(0.75, 0.0, 0.25)).length() < 1e-15);
         assert_eq!(g.evaluate(DVec3::new(0.0, -4.0, 0.0)), Color::X);
         assert_eq!(g.evaluate(DVec3::new(0.0, 40.0, 0.0)), Color::Z);
         assert!(Gradient::new([Color::X, Color::Z], DVec3::ZERO, 0.0, 1.0).is_none());

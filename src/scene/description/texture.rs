@@ -26,8 +26,7 @@ impl<'de> Deserialize<'de> for ColorDescription {
                 f.write_str("an RGB array such as [0.5, 0.5, 0.5] or a texture table such as { image = \"file.png\" }")
             }
             fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Self::Value, A::Error> {
-                Vector::deserialize(de::value::SeqAccessDeserializer::new(seq))
-                    .map(ColorDescription::Rgb)
+                Vector::deserialize(de::value::SeqAccessDeserializer::new(seq)).map(ColorDescription::Rgb)
             }
             fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<Self::Value, A::Error> {
                 TextureDescription::deserialize(de::value::MapAccessDeserializer::new(map))
@@ -113,9 +112,7 @@ impl<'de, const N: usize> Deserialize<'de> for Numbers<N> {
             fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
                 let mut values = [0.0; N];
                 for (i, value) in values.iter_mut().enumerate() {
-                    *value = seq
-                        .next_element()?
-                        .ok_or_else(|| de::Error::invalid_length(i, &self))?;
+                    *value = seq.next_element()?.ok_or_else(|| de::Error::invalid_length(i, &self))?;
                 }
                 if seq.next_element::<f64>()?.is_some() {
                     return Err(de::Error::invalid_length(N + 1, &self));

@@ -4,12 +4,8 @@
 use super::{Builder, find_key};
 use crate::color::Color;
 use crate::geometry::Transform;
-use crate::material::texture::{
-    Gradient, ImageCache, Mapping, PlanarProjection, Projection, SphereProjection, Texture, Wrap,
-};
-use crate::scene::description::{
-    ColorDescription, MappingKind, Numbers, TextureDescription, Vector, WrapKind,
-};
+use crate::material::texture::{Gradient, ImageCache, Mapping, PlanarProjection, Projection, SphereProjection, Texture, Wrap};
+use crate::scene::description::{ColorDescription, MappingKind, Numbers, TextureDescription, Vector, WrapKind};
 use crate::scene::error::{SceneError, line_of};
 use glam::{DVec2, DVec3};
 use std::ops::Range;
@@ -59,21 +55,14 @@ impl Builder<'_> {
             at_most_one,
         };
         match color {
-            ColorDescription::Rgb(rgb) => {
-                Ok(Texture::Constant(self.reflectance(&field, None, *rgb)?))
-            }
+            ColorDescription::Rgb(rgb) => Ok(Texture::Constant(self.reflectance(&field, None, *rgb)?)),
             ColorDescription::Texture(table) => self.texture_table(&field, table, images),
         }
     }
 
     /// An error about `key` inside the texture table of `field` (or about the
     /// whole field when `key` is `None`), at the line where the key is written.
-    fn texture_error(
-        &self,
-        field: &Field,
-        key: Option<&str>,
-        message: impl Into<String>,
-    ) -> SceneError {
+    fn texture_error(&self, field: &Field, key: Option<&str>, message: impl Into<String>) -> SceneError {
         let mut error = self.error(field.span.clone(), field.path, field.name, message);
         if let (Some(key), Some(span)) = (key, field.span) {
             let body = &self.text[span.start.min(self.text.len())..span.end.min(self.text.len())];
@@ -86,52 +75,27 @@ impl Builder<'_> {
         error
     }
 
-    fn reflectance(
-        &self,
-        field: &Field,
-        key: Option<&str>,
-        rgb: Vector,
-    ) -> Result<Color, SceneError> {
+    fn reflectance(&self, field: &Field, key: Option<&str>, rgb: Vector) -> Result<Color, SceneError> {
         if rgb.iter().any(|v| !v.is_finite()) {
-            return Err(self.texture_error(
-                field,
-                key,
-                "must be a finite number (found NaN or infinity)",
-            ));
+            return Err(self.texture_error(field, key, "must be a finite number (found NaN or infinity)"));
         }
         if rgb.iter().any(|&v| v < 0.0) {
             return Err(self.texture_error(field, key, "colour components must not be negative"));
         }
         if field.at_most_one && rgb.iter().any(|&v| v > 1.0) {
-            return Err(self.texture_error(
-                field,
-                key,
-                "must not exceed 1 (it would create energy)",
-            ));
+            return Err(self.texture_error(field, key, "must not exceed 1 (it would create energy)"));
         }
         Ok(DVec3::from_array(rgb))
     }
 
-    fn finite_vector(
-        &self,
-        field: &Field,
-        key: &str,
-        v: Option<Vector>,
-    ) -> Result<Option<DVec3>, SceneError> {
+    fn finite_vector(&self, field: &Field, key: &str, v: Option<Vector>) -> Result<Option<DVec3>, SceneError> {
         match v {
-            Some(v) if v.iter().any(|c| !c.is_finite()) => {
-                Err(self.texture_error(field, Some(key), "must be finite numbers"))
-            }
+            Some(v) if v.iter().any(|c| !c.is_finite()) => Err(self.texture_error(field, Some(key), "must be finite numbers")),
             v => Ok(v.map(DVec3::from_array)),
         }
     }
 
-    fn texture_table(
-        &self,
-        field: &Field,
-        t: &TextureDescription,
-        images: &mut ImageCache,
-    ) -> Result<Texture, SceneError> {
+    fn texture_table(&self, field: &Field, t: &TextureDescription, images: &mut ImageCache) -> Result<Texture, SceneError> {
         // Exactly one pattern.
         let named: Vec<Pattern> = [
             (t.image.is_some(), Pattern::Image),
@@ -144,11 +108,7 @@ impl Builder<'_> {
         let pattern = match named.as_slice() {
             [one] => *one,
             [] => {
-                return Err(self.texture_error(
-                    field,
-                    None,
-                    "a texture table needs one of `image`, `checker` or `gradient`",
-                ));
+                return Err(self.texture_error(field, None, "a texture table needs one of `image`, `checker` or `gradient`"));
             }
             [_, second, ..] => {
                 return Err(self.texture_error(
@@ -177,8 +137,17 @@ impl Builder<'_> {
             }
         };
         use Pattern::{Checker, Image};
-        only(t.mapping.is_some(), "mapping", &[Image, Checker])?;
-        only(t.scale.is_some(), "scale", &[Image, Checker])?;
+        for (present, key) in [
+            (t.mapping.is_some(), "mapping"),
+            (t.scale.is_some(), "scale"),
+            (t.rotate_degrees.is_some(), "rotate_degrees"),
+            (t.center.is_some(), "center"),
+            (t.origin.is_some(), "origin"),
+            (t.edge_u.is_some(), "edge_u"),
+            (t.edge_v.is_some(), "edge_v"),
+        ] {
+            only(present, key, &[Image, Checker])?;
+        }
         only(t.wrap.is_some(), "wrap", &[Image])?;
         only(t.axis.is_some(), "axis", &[Pattern::Gradient])?;
         only(t.from.is_some(), "from", &[Pattern::Gradient])?;
@@ -191,18 +160,11 @@ impl Builder<'_> {
                     self.reflectance(field, Some("gradient"), colors[0])?,
                     self.reflectance(field, Some("gradient"), colors[1])?,
                 ];
-                self.mapping(field, t, MappingKind::Uv)?; // rejects mapping-specific keys
-                let axis = self
-                    .finite_vector(field, "axis", t.axis)?
-                    .unwrap_or(DVec3::Y);
+                let axis = self.finite_vector(field, "axis", t.axis)?.unwrap_or(DVec3::Y);
                 let (from, to) = (t.from.unwrap_or(0.0), t.to.unwrap_or(1.0));
                 let gradient = Gradient::new(colors, axis, from, to).ok_or_else(|| {
                     let key = if axis == DVec3::ZERO { "axis" } else { "to" };
-                    self.texture_error(
-                        field,
-                        Some(key),
-                        "needs a non-zero `axis` and finite `from` ≠ `to`",
-                    )
+                    self.texture_error(field, Some(key), "needs a non-zero `axis` and finite `from` ≠ `to`")
                 })?;
                 Ok(Texture::Gradient(gradient))
             }
@@ -229,29 +191,16 @@ impl Builder<'_> {
                 let image = images
                     .load(&file)
                     .map_err(|e| self.texture_error(field, Some("image"), e.to_string()))?;
-                Ok(Texture::Image {
-                    image,
-                    mapping,
-                    wrap,
-                })
+                Ok(Texture::Image { image, mapping, wrap })
             }
         }
     }
 
     /// The mapping `kind` with its keys; keys of other mappings are errors.
-    fn mapping(
-        &self,
-        field: &Field,
-        t: &TextureDescription,
-        kind: MappingKind,
-    ) -> Result<Mapping, SceneError> {
+    fn mapping(&self, field: &Field, t: &TextureDescription, kind: MappingKind) -> Result<Mapping, SceneError> {
         let misplaced = |present: bool, key: &str, wanted: &str| {
             if present {
-                Err(self.texture_error(
-                    field,
-                    Some(key),
-                    format!("applies only with mapping = \"{wanted}\""),
-                ))
+                Err(self.texture_error(field, Some(key), format!("applies only with mapping = \"{wanted}\"")))
             } else {
                 Ok(())
             }
@@ -280,34 +229,23 @@ impl Builder<'_> {
                 };
                 let degrees = self.finite_vector(field, "rotate_degrees", degrees)?;
                 // The same Euler convention as object transforms.
-                let rotation =
-                    degrees.map(|d| Transform::new(DVec3::ZERO, d, DVec3::ONE).to_world.matrix3);
+                let rotation = degrees.map(|d| Transform::new(DVec3::ZERO, d, DVec3::ONE).to_world.matrix3);
                 let center = self.finite_vector(field, "center", t.center)?;
                 Projection::Sphere(SphereProjection::new(rotation, center))
             }
             MappingKind::Planar => {
                 let mut corners = [DVec3::ZERO; 3];
-                for (corner, (key, value)) in corners.iter_mut().zip([
-                    ("origin", t.origin),
-                    ("edge_u", t.edge_u),
-                    ("edge_v", t.edge_v),
-                ]) {
-                    *corner = self.finite_vector(field, key, value)?.ok_or_else(|| {
-                        self.texture_error(
-                            field,
-                            Some("mapping"),
-                            format!("planar mapping needs `{key}`"),
-                        )
-                    })?;
+                for (corner, (key, value)) in
+                    corners
+                        .iter_mut()
+                        .zip([("origin", t.origin), ("edge_u", t.edge_u), ("edge_v", t.edge_v)])
+                {
+                    *corner = self
+                        .finite_vector(field, key, value)?
+                        .ok_or_else(|| self.texture_error(field, Some("mapping"), format!("planar mapping needs `{key}`")))?;
                 }
-                let plane =
-                    PlanarProjection::new(corners[0], corners[1], corners[2]).ok_or_else(|| {
-                        self.texture_error(
-                            field,
-                            Some("edge_v"),
-                            "edges must not be parallel or zero",
-                        )
-                    })?;
+                let plane = PlanarProjection::new(corners[0], corners[1], corners[2])
+                    .ok_or_else(|| self.texture_error(field, Some("edge_v"), "edges must not be parallel or zero"))?;
                 Projection::Planar(plane)
             }
         };
