@@ -25,7 +25,7 @@ fi
 bin=${PRISM_BIN:-}
 if [[ -z $bin ]]; then
     cargo build --quiet --bin prism
-    bin=target/debug/prism
+    bin=${CARGO_TARGET_DIR:-target}/debug/prism
 fi
 screenshot=${SCREENSHOT:-target/gui-smoke/viewer.png}
 settle=${SETTLE_SECONDS:-4}
