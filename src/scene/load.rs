@@ -42,21 +42,12 @@ pub fn load_scene_file(path: &Path) -> Result<LoadedScene, SceneError> {
 pub fn load_scene_str(text: &str, file: &Path, base: &Path) -> Result<LoadedScene, SceneError> {
     let description: SceneDescription = toml::from_str(text).map_err(|e| {
         let message = e.message().to_string();
-        let line = e.span().map(|span| {
-            // Tagged tables report errors at their start; point at the
-            // offending key itself when the message names it.
-            let key = message
-                .strip_prefix("unknown field `")
-                .and_then(|rest| rest.split('`').next());
-            let start = span.start.min(text.len());
-            let next_header = text[start + 1.min(text.len() - start)..]
-                .find("\n[")
-                .map_or(text.len(), |i| start + 1 + i);
-            let offset = key
-                .and_then(|k| find_key(&text[start..next_header.max(start)], k))
-                .unwrap_or(0);
-            line_of(text, start + offset)
-        });
+        // Tagged tables report errors at their start; point at the offending
+        // key itself when the message names it.
+        let key = message
+            .strip_prefix("unknown field `")
+            .and_then(|rest| rest.split('`').next());
+        let line = e.span().map(|span| key_line(text, span, key));
         SceneError::new(file, line, None, message)
     })?;
     Builder { text, file, base }.build(description)
@@ -72,15 +63,7 @@ impl Builder<'_> {
     /// An error about `field` of the table spanning `span`, at the line where
     /// that key is written (or where the table starts).
     fn error(&self, span: Option<Range<usize>>, path: &str, field: &str, message: impl Into<String>) -> SceneError {
-        let line = span.map(|span| {
-            // A `[[table]]`'s span may cover only its header: search on to the
-            // next header as well.
-            let start = span.start.min(self.text.len());
-            let next_header = self.text[start..].find("\n[").map_or(self.text.len(), |i| start + i);
-            let end = span.end.min(self.text.len()).max(next_header);
-            let key_offset = find_key(&self.text[start..end], field).unwrap_or(0);
-            line_of(self.text, start + key_offset)
-        });
+        let line = span.map(|span| key_line(self.text, span, Some(field)));
         let full = if path.is_empty() {
             field.to_string()
         } else {
@@ -405,6 +388,17 @@ impl Builder<'_> {
             DVec3::from_array(scale),
         ))
     }
+}
+
+/// 1-based line of `key` inside the table spanning `span`, or of the table's
+/// start when the key is not found. A `[[table]]`'s span may cover only its
+/// header, so the search runs on to the next header as well.
+fn key_line(text: &str, span: Range<usize>, key: Option<&str>) -> usize {
+    let start = span.start.min(text.len());
+    let next_header = text[start..].find("\n[").map_or(text.len(), |i| start + i);
+    let end = span.end.min(text.len()).max(next_header);
+    let offset = key.and_then(|k| find_key(&text[start..end], k)).unwrap_or(0);
+    line_of(text, start + offset)
 }
 
 /// Byte offset of `key =` (at a line start or after `{`/`,`) within `body`.
