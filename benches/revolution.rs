@@ -41,10 +41,15 @@ fn point(points: &[DVec2], t: f64) -> DVec2 {
     sum
 }
 
+/// The hodograph evaluated at `t`, without allocating (the baseline should
+/// not be slowed by the heap).
 fn derivative(points: &[DVec2], t: f64) -> DVec2 {
     let n = points.len() - 1;
-    let differences: Vec<DVec2> = points.windows(2).map(|w| (w[1] - w[0]) * n as f64).collect();
-    point(&differences, t)
+    let mut differences = [DVec2::ZERO; 16];
+    for (difference, pair) in differences.iter_mut().zip(points.windows(2)) {
+        *difference = (pair[1] - pair[0]) * n as f64;
+    }
+    point(&differences[..n], t)
 }
 
 struct Random(u64);

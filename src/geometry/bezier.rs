@@ -54,6 +54,12 @@ pub fn binomial(n: usize, k: usize) -> f64 {
     if k > n { 0.0 } else { BINOMIAL[n][k] }
 }
 
+/// Row `n ≤ 2 · MAX_DEGREE` of Pascal's triangle, `C(n, k)` for every `k`
+/// (zero beyond `k = n`), for loops that need a whole row.
+pub fn binomial_row(n: usize) -> &'static [f64; MAX_COEFFICIENTS] {
+    &BINOMIAL[n]
+}
+
 // ---------------------------------------------------------------------------
 // Planar Bezier curves.
 
@@ -244,6 +250,10 @@ pub trait PolynomialPiece: Sized {
     /// Writes the Bernstein coefficients over this piece into `out` and
     /// returns their count and an absolute bound on their rounding error.
     fn coefficients(&self, out: &mut [f64; MAX_COEFFICIENTS]) -> (usize, f64);
+    /// The values at `τ = 0` and `τ = 1`: the first and last Bernstein
+    /// coefficients, bit for bit what `coefficients` would write there, but
+    /// without forming the others.
+    fn end_values(&self) -> (f64, f64);
     /// The two halves `τ ∈ [0, ½]` and `[½, 1]`.
     fn split_half(&self) -> (Self, Self);
     /// The polynomial and its `τ`-derivative at local parameter `τ`.
@@ -273,23 +283,28 @@ const PIECE_BUDGET: usize = 4096;
 /// `t`) that may still hold roots are reported once as a cluster at their
 /// midpoint, as is a piece on which the polynomial is zero within its
 /// error bound.
+///
+/// `skip` is asked about every piece before it is examined; a piece for
+/// which it answers `true` is dropped with its roots. A nearest-hit search
+/// uses it to drop pieces whose roots can only be farther than the best hit
+/// found so far (its answer may change as roots are reported).
 pub fn isolate_roots<P: PolynomialPiece>(
     piece: &P,
     t0: f64,
     t1: f64,
     minimum_width: f64,
+    skip: &mut impl FnMut(&P) -> bool,
     on_root: &mut impl FnMut(&P, IsolatedRoot),
 ) {
-    let mut coefficients = [0.0; MAX_COEFFICIENTS];
-    let (count, _) = piece.coefficients(&mut coefficients);
+    let (start, end) = piece.end_values();
     // Roots exactly at the ends of the whole interval; inner split points are
     // reported where they are created.
-    if count > 0 && coefficients[0] == 0.0 {
+    if start == 0.0 {
         on_root(piece, exact_root(0.0, t0, t0, t1));
     }
     let mut budget = PIECE_BUDGET;
-    isolate_recursive(piece, t0, t1, minimum_width, &mut budget, on_root);
-    if count > 0 && coefficients[count - 1] == 0.0 {
+    isolate_recursive(piece, t0, t1, minimum_width, &mut budget, skip, on_root);
+    if end == 0.0 {
         on_root(piece, exact_root(1.0, t1, t0, t1));
     }
 }
@@ -309,9 +324,10 @@ fn isolate_recursive<P: PolynomialPiece>(
     t1: f64,
     minimum_width: f64,
     budget: &mut usize,
+    skip: &mut impl FnMut(&P) -> bool,
     on_root: &mut impl FnMut(&P, IsolatedRoot),
 ) {
-    if *budget == 0 {
+    if *budget == 0 || skip(piece) {
         return;
     }
     *budget -= 1;
@@ -354,7 +370,7 @@ fn isolate_recursive<P: PolynomialPiece>(
 
     // Step 3: exactly one root, bracketed by end values of opposite sign.
     if sign_variations(coefficients) == 1 && first * last < 0.0 {
-        let (tau, tau_uncertainty) = polish_root(piece, first, last);
+        let (tau, tau_uncertainty) = polish_root(piece, first, last, error);
         on_root(
             piece,
             IsolatedRoot {
@@ -385,21 +401,25 @@ fn isolate_recursive<P: PolynomialPiece>(
     // Step 5: split in half and recurse, left first; a root exactly at the
     // split point is reported once, here.
     let (left, right) = piece.split_half();
-    isolate_recursive(&left, t0, middle, minimum_width, budget, on_root);
-    let mut right_coefficients = [0.0; MAX_COEFFICIENTS];
-    let (right_count, _) = right.coefficients(&mut right_coefficients);
-    if right_count > 0 && right_coefficients[0] == 0.0 {
+    isolate_recursive(&left, t0, middle, minimum_width, budget, skip, on_root);
+    if right.end_values().0 == 0.0 {
         on_root(&right, exact_root(0.0, middle, t0, t1));
     }
-    isolate_recursive(&right, middle, t1, minimum_width, budget, on_root);
+    isolate_recursive(&right, middle, t1, minimum_width, budget, skip, on_root);
 }
 
 /// Safeguarded Newton iteration on `τ ∈ [0, 1]` where `p(0) = value_at_0` and
 /// `p(1) = value_at_1` have opposite signs (Numerical Recipes' `rtsafe`):
 /// a Newton step is taken when it stays inside the bracket and at least
-/// halves the previous step, otherwise the bracket is bisected. Returns the
-/// root and a bound on its distance to the true root of the computed `p`.
-fn polish_root<P: PolynomialPiece>(piece: &P, value_at_0: f64, value_at_1: f64) -> (f64, f64) {
+/// halves the previous step, otherwise the bracket is bisected.
+///
+/// `noise` bounds the rounding error of an evaluated `p`. Where `|p(τ)|` is
+/// below it the sign of `p` carries no information: such a value does not
+/// move the bracket, and once Newton's steps stop shrinking there the
+/// iteration ends, since bisecting on noisy signs (down to the last bit, as
+/// plain `rtsafe` would) cannot improve the root. Returns the root and the
+/// size of the last step (or the bracket, if smaller) as its uncertainty.
+fn polish_root<P: PolynomialPiece>(piece: &P, value_at_0: f64, value_at_1: f64, noise: f64) -> (f64, f64) {
     let (mut low, mut high) = (0.0_f64, 1.0_f64);
     let low_is_negative = value_at_0 < 0.0;
     // Start from the secant (regula falsi) point, well inside the bracket.
@@ -410,13 +430,24 @@ fn polish_root<P: PolynomialPiece>(piece: &P, value_at_0: f64, value_at_1: f64) 
         if value == 0.0 {
             return (tau, f64::EPSILON);
         }
-        if (value < 0.0) == low_is_negative {
-            low = tau;
-        } else {
-            high = tau;
+        let in_noise = value.abs() <= noise;
+        if !in_noise {
+            if (value < 0.0) == low_is_negative {
+                low = tau;
+            } else {
+                high = tau;
+            }
         }
         let newton = tau - value / derivative;
         let step_ok = newton.is_finite() && newton > low && newton < high && (newton - tau).abs() < 0.5 * previous_step;
+        if in_noise && !step_ok {
+            let step = if newton.is_finite() {
+                (newton - tau).abs()
+            } else {
+                high - low
+            };
+            return (tau, (2.0 * step).max(4.0 * f64::EPSILON).min(high - low));
+        }
         let next = if step_ok { newton } else { 0.5 * (low + high) };
         let step = (next - tau).abs();
         previous_step = step;
@@ -464,6 +495,10 @@ impl PolynomialPiece for BernsteinPiece {
         (self.count, self.error)
     }
 
+    fn end_values(&self) -> (f64, f64) {
+        (self.coefficients[0], self.coefficients[self.count - 1])
+    }
+
     fn split_half(&self) -> (Self, Self) {
         let mut left = *self;
         let mut right = *self;
@@ -499,9 +534,14 @@ mod tests {
     fn roots_of(coefficients: &[f64]) -> Vec<IsolatedRoot> {
         let mut found = Vec::new();
         let error = gamma(4 * coefficients.len() as u32) * coefficients.iter().fold(0.0_f64, |m, c| m.max(c.abs()));
-        isolate_roots(&BernsteinPiece::new(coefficients, error), 0.0, 1.0, 1e-13, &mut |_, root| {
-            found.push(root)
-        });
+        isolate_roots(
+            &BernsteinPiece::new(coefficients, error),
+            0.0,
+            1.0,
+            1e-13,
+            &mut |_| false,
+            &mut |_, root| found.push(root),
+        );
         found
     }
 
