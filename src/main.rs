@@ -262,12 +262,17 @@ fn render_command(args: RenderArgs) -> Result<()> {
     }
     if !args.quiet {
         eprintln!(
-            "wrote {} ({}x{}, {} passes of {})",
+            "wrote {} ({}x{}, {} passes of {}{})",
             args.output.display(),
             frame.width,
             frame.height,
             integrator.passes(),
-            settings.integrator
+            settings.integrator,
+            if integrator.converged() {
+                "; adaptive sampling stopped every pixel"
+            } else {
+                ""
+            }
         );
     }
     Ok(())

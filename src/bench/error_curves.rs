@@ -182,14 +182,17 @@ pub fn measure_curve(
                 settings.integrator
             )));
         }
-        if render_seconds < ladder[next] {
+        // Once adaptive sampling has stopped every pixel the estimate is
+        // final: the remaining rungs get it, at the time actually spent.
+        let converged = integrator.converged();
+        if render_seconds < ladder[next] && !converged {
             continue;
         }
         let frame = integrator.frame();
         let metrics = error_metrics(&frame, reference)?;
         let status = integrator.status();
         // One slow pass can cross several rungs; each gets the same estimate.
-        while next < ladder.len() && render_seconds >= ladder[next] {
+        while next < ladder.len() && (render_seconds >= ladder[next] || converged) {
             points.push(CurvePoint {
                 target_seconds: ladder[next],
                 elapsed_seconds: render_seconds,

@@ -29,6 +29,13 @@ pub trait Integrator: Send {
         0
     }
 
+    /// Adaptive sampling has stopped every pixel, so further passes would
+    /// add nothing: progressive drivers stop here, before any sample or time
+    /// target.
+    fn converged(&self) -> bool {
+        false
+    }
+
     /// A short status, e.g. the SPPM radius; empty by default.
     fn status(&self) -> String {
         String::new()

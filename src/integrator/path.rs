@@ -14,6 +14,7 @@ use crate::render::settings::{IntegratorKind, RenderSettings};
 use crate::sampler::{Sampler, SamplerKind};
 use crate::scene::Scene;
 use glam::DVec2;
+use rayon::prelude::*;
 use std::sync::atomic::AtomicBool;
 
 /// Bounces before Russian roulette may end a path.
@@ -134,6 +135,8 @@ pub struct PathIntegrator {
     film: Film,
     passes: u32,
     adaptive_threshold: Option<f64>,
+    /// Every pixel has met the adaptive threshold (see `Integrator::converged`).
+    converged: bool,
 }
 
 impl PathIntegrator {
@@ -145,6 +148,7 @@ impl PathIntegrator {
             film: Film::new(settings.width, settings.height),
             passes: 0,
             adaptive_threshold: settings.adaptive_threshold,
+            converged: false,
         }
     }
 
@@ -174,8 +178,17 @@ impl Integrator for PathIntegrator {
         });
         if completed {
             self.passes += 1;
+            // A stopped pixel stays stopped (its state no longer changes), so
+            // once all are, every later pass would be empty.
+            self.converged = self
+                .adaptive_threshold
+                .is_some_and(|threshold| self.film.pixels.par_iter().all(|p| pass::is_converged(p, threshold)));
         }
         completed
+    }
+
+    fn converged(&self) -> bool {
+        self.converged
     }
 
     fn passes(&self) -> u32 {
@@ -192,6 +205,7 @@ impl Integrator for PathIntegrator {
 
     fn status(&self) -> String {
         match self.adaptive_threshold {
+            Some(_) if self.converged => "adaptive: converged, 0% of pixels active".to_string(),
             Some(threshold) => {
                 let converged = self.film.pixels.iter().filter(|p| pass::is_converged(p, threshold)).count();
                 let active = 100.0 * (1.0 - converged as f64 / self.film.pixels.len().max(1) as f64);

@@ -40,9 +40,10 @@ impl Progress {
     }
 }
 
-/// Renders passes until the sample target or time limit is reached or
-/// `cancel` is raised, calling `on_pass` after each completed pass. At least
-/// one pass is rendered unless cancelled. Runs on the current rayon pool.
+/// Renders passes until the sample target or time limit is reached, adaptive
+/// sampling has stopped every pixel (`Integrator::converged`), or `cancel` is
+/// raised, calling `on_pass` after each completed pass. At least one pass is
+/// rendered unless cancelled. Runs on the current rayon pool.
 pub fn render_progressive(
     scene: &Scene,
     camera: &Camera,
@@ -63,7 +64,7 @@ pub fn render_progressive(
             time_limit: settings.time_limit,
         };
         on_pass(integrator.as_ref(), &progress);
-        if progress.finished() {
+        if progress.finished() || integrator.converged() {
             break;
         }
     }

@@ -127,6 +127,34 @@ mod tests {
         assert!(is_converged(&film.pixels[1], threshold));
     }
 
+    /// A render whose pixels have all converged stops there, not at its
+    /// sample target: under a constant background every sample is equal, so
+    /// every pixel stops at exactly the minimum count. The Cornell box at the
+    /// same threshold is still noisy after 40 passes and runs to its target.
+    #[test]
+    fn adaptive_render_stops_once_every_pixel_has_converged() {
+        let loaded = load_scene_str(DEFAULT_SCENE, Path::new("cornell"), Path::new(".")).expect("default scene loads");
+        let sky = crate::scene::Scene::new(Vec::new(), Vec::new(), Vec::new(), Color::splat(0.7));
+        let settings = RenderSettings {
+            width: 8,
+            height: 6,
+            samples_per_pixel: Some(10_000),
+            adaptive_threshold: Some(0.05),
+            ..loaded.settings.clone()
+        };
+        let integrator = render_with_threads(&sky, &loaded.camera, &settings, Some(2)).expect("pool");
+        assert!(integrator.converged(), "{}", integrator.status());
+        assert_eq!(integrator.passes(), ADAPTIVE_MIN_SAMPLES);
+
+        let noisy = RenderSettings {
+            samples_per_pixel: Some(40),
+            ..settings
+        };
+        let integrator = render_with_threads(&loaded.scene, &loaded.camera, &noisy, Some(2)).expect("pool");
+        assert!(!integrator.converged(), "{}", integrator.status());
+        assert_eq!(integrator.passes(), 40);
+    }
+
     /// Same seed, same image, with 1 or 2 threads, adaptive sampling on: a
     /// pixel's activity depends only on its own samples. Exact equality: any
     /// dependence on scheduling would change some pixel's sample count.

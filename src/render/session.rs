@@ -463,7 +463,7 @@ impl Worker {
             elapsed: self.elapsed,
             time_limit: settings.time_limit,
         };
-        if progress.finished() {
+        if progress.finished() || integrator.converged() {
             self.mode = SessionState::Finished;
         }
         let frame = integrator.frame();
