@@ -12,8 +12,9 @@
 //! saw along their specular chains, averaged over iterations (with a few
 //! extra camera paths per iteration for that cheap term). All light
 //! reflected diffusely (direct lighting included) comes from photons: the
-//! classic form, consistent as R → 0. A non-black background is seen
-//! directly and through glass, but emits no photons, so it lights nothing.
+//! classic form, consistent as R → 0. A non-black background is a light
+//! like any other: seen directly and through glass by camera paths, and a
+//! source of photons from every direction ([`photon::PhotonSources`]).
 //!
 //! Every sample is seeded by (pixel or photon index, iteration, seed), so the
 //! image does not depend on which thread traced what, up to the summation
@@ -33,6 +34,7 @@ use crate::render::settings::{RenderSettings, SppmSettings};
 use crate::sampler::{Sampler, SamplerKind};
 use crate::scene::Scene;
 use grid::VisiblePointGrid;
+use photon::PhotonSources;
 use rayon::prelude::*;
 use statistics::{PhotonTally, PixelStatistics};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -64,11 +66,11 @@ const INITIAL_RADIUS_PIXELS: f64 = 1.5;
 /// wall at a corner). Smooth surfaces agree ever better as the radius shrinks.
 const NORMAL_AGREEMENT: f64 = 0.5;
 
-/// The scale photon tallies count in: the lights' total power, about one
-/// photon's flux, so fixed-point sums keep the same relative precision in
-/// any scene's units.
-fn flux_unit(scene: &Scene) -> f64 {
-    scene.lights.total_power.max(f64::MIN_POSITIVE)
+/// The scale photon tallies count in: the total emitted power (shapes and
+/// sky), about one photon's flux, so fixed-point sums keep the same relative
+/// precision in any scene's units.
+fn flux_unit(sources: &PhotonSources) -> f64 {
+    sources.total_power().max(f64::MIN_POSITIVE)
 }
 
 /// The radius a pixel starts with: the absolute setting, or a few pixel
@@ -210,7 +212,8 @@ impl SppmIntegrator {
     fn photon_pass(&self, scene: &Scene, visible: &[Option<VisiblePoint>], grid: &VisiblePointGrid, cancel: &AtomicBool) -> bool {
         let (kind, iteration, max_depth) = (self.sampler, self.iterations, self.max_depth);
         let seed = self.seed ^ PHOTON_SEED;
-        let inverse_unit = 1.0 / flux_unit(scene);
+        let sources = PhotonSources::new(scene);
+        let inverse_unit = 1.0 / flux_unit(&sources);
         (0..self.parameters.photons_per_iteration)
             .into_par_iter()
             .with_min_len(64)
@@ -219,7 +222,7 @@ impl SppmIntegrator {
                     return;
                 }
                 let mut sampler = Sampler::new(kind, index as u64, iteration, seed);
-                let Some(emitted) = photon::emit(scene, &mut sampler) else {
+                let Some(emitted) = sources.emit(scene, &mut sampler) else {
                     return;
                 };
                 photon::trace(scene, emitted, &mut sampler, max_depth, |hit, towards_light, flux| {
@@ -246,7 +249,7 @@ impl SppmIntegrator {
     /// Step 4: folds each pixel's tally into its statistics.
     fn update_statistics(&mut self, scene: &Scene, visible: &[Option<VisiblePoint>]) {
         let alpha = self.parameters.alpha;
-        let unit = flux_unit(scene);
+        let unit = flux_unit(&PhotonSources::new(scene));
         let rejected = AtomicU64::new(0);
         self.pixels
             .par_iter_mut()

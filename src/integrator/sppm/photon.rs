@@ -1,12 +1,19 @@
-//! The photon pass of SPPM: photons leave the emissive shapes and bounce
-//! through the scene, handing their flux to a callback at every
+//! The photon pass of SPPM: photons leave the emissive shapes and the sky
+//! and bounce through the scene, handing their flux to a callback at every
 //! non-specular surface they hit (Hachisuka & Jensen 2009, §3; Jensen 2001).
 //!
-//! Emission: a light is chosen in proportion to its power (`Lights::choose`),
-//! a point uniformly on its area, and a direction cosine-weighted about the
-//! normal (about either face, with probability ½ each, for two-sided lights),
-//! so every photon carries flux Φ = Le·cos θ / (p_select · p_area · p_dir)
-//! = π·A·Le·(sides) / p_select.
+//! Emission: a source is chosen in proportion to its power, then
+//! - from an emissive shape (`Lights::choose`): a point uniformly on its
+//!   area and a direction cosine-weighted about the normal (about either
+//!   face, with probability ½ each, for two-sided lights), so every photon
+//!   carries flux Φ = Le·cos θ / (p_select · p_area · p_dir)
+//!   = π·A·Le·(sides) / p_select;
+//! - from the sky (a constant background radiance L, arriving from every
+//!   direction): a direction ω uniformly on the sphere, and a point uniformly
+//!   on the disc of the scene's bounding sphere (radius R) that faces ω, the
+//!   photon travelling along −ω (pbrt-v4 §12.5, `UniformInfiniteLight::SampleLe`).
+//!   Every photon crossing the bounding sphere is reachable this way, and it
+//!   carries Φ = L / (p_select · p_ω · p_disc) = 4π · πR² · L / p_select.
 
 use crate::color::{Color, luminance};
 use crate::geometry::SurfaceHit;
@@ -14,6 +21,7 @@ use crate::material::{ShadingPoint, Transport};
 use crate::math::{DVec3, Frame as ShadingFrame, Ray, warp};
 use crate::sampler::Sampler;
 use crate::scene::Scene;
+use std::f64::consts::PI;
 
 /// A photon leaving a light.
 #[derive(Clone, Copy, Debug)]
@@ -23,10 +31,78 @@ pub struct Photon {
     pub flux: Color,
 }
 
-/// Draws one photon from the scene's lights; `None` if there are none or
-/// the sample is degenerate.
-pub fn emit(scene: &Scene, sampler: &mut Sampler) -> Option<Photon> {
-    let (index, select_probability) = scene.lights.choose(sampler.next_1d())?;
+/// A constant, non-black background as a photon source.
+#[derive(Clone, Copy, Debug)]
+struct Sky {
+    radiance: Color,
+    /// Bounding sphere of the scene's geometry.
+    center: DVec3,
+    radius: f64,
+    /// Luminance of the power it sends into the bounding sphere, 4π · πR² · L.
+    power: f64,
+}
+
+/// Everything that emits photons: the emissive shapes and, if the
+/// background is not black, the sky.
+#[derive(Clone, Copy, Debug)]
+pub struct PhotonSources {
+    sky: Option<Sky>,
+    /// Probability of emitting from the sky rather than from a shape.
+    sky_probability: f64,
+    total_power: f64,
+}
+
+impl PhotonSources {
+    pub fn new(scene: &Scene) -> Self {
+        let bounds = scene.bounds();
+        let radius = 0.5 * bounds.extent().length();
+        let sky = (luminance(scene.background) > 0.0 && !bounds.is_empty() && radius.is_finite() && radius > 0.0).then(|| {
+            // Slightly larger, so photons start outside every surface.
+            let radius = radius * (1.0 + 1e-6);
+            Sky {
+                radiance: scene.background,
+                center: bounds.centroid(),
+                radius,
+                power: 4.0 * PI * PI * radius * radius * luminance(scene.background),
+            }
+        });
+        let sky_power = sky.map_or(0.0, |s| s.power);
+        let total_power = scene.lights.total_power + sky_power;
+        Self {
+            sky,
+            sky_probability: if total_power > 0.0 { sky_power / total_power } else { 0.0 },
+            total_power,
+        }
+    }
+
+    /// Luminance of the total emitted power: the scale of one photon's flux.
+    pub fn total_power(&self) -> f64 {
+        self.total_power
+    }
+
+    /// Draws one photon; `None` if nothing emits or the sample is degenerate.
+    /// Without a sky, the samples drawn are exactly those of a scene whose
+    /// only sources are its shapes.
+    pub fn emit(&self, scene: &Scene, sampler: &mut Sampler) -> Option<Photon> {
+        let u_select = sampler.next_1d();
+        let Some(sky) = self.sky else {
+            return emit_from_shape(scene, u_select, 1.0, sampler);
+        };
+        let p_sky = self.sky_probability;
+        if u_select < p_sky {
+            return emit_from_sky(&sky, p_sky, sampler);
+        }
+        // Reuse the selection sample: it is uniform on [p_sky, 1) here.
+        let u_shape = ((u_select - p_sky) / (1.0 - p_sky)).min(1.0 - f64::EPSILON / 2.0);
+        emit_from_shape(scene, u_shape, 1.0 - p_sky, sampler)
+    }
+}
+
+/// A photon from the emissive shapes, chosen by `u_select`, which is itself
+/// chosen with probability `shape_probability`.
+fn emit_from_shape(scene: &Scene, u_select: f64, shape_probability: f64, sampler: &mut Sampler) -> Option<Photon> {
+    let (index, light_probability) = scene.lights.choose(u_select)?;
+    let select_probability = light_probability * shape_probability;
     let light = &scene.lights.lights[index as usize];
     let shape = &scene.primitives[light.primitive as usize].shape;
     let on_light = shape.sample_area(sampler.next_2d());
@@ -48,6 +124,29 @@ pub fn emit(scene: &Scene, sampler: &mut Sampler) -> Option<Photon> {
         ray: Ray::spawn(on_light.point, on_light.point_error, normal, direction),
         flux,
     })
+}
+
+/// A photon from the sky, which was chosen with probability `select_probability`.
+fn emit_from_sky(sky: &Sky, select_probability: f64, sampler: &mut Sampler) -> Option<Photon> {
+    let towards_sky = warp::square_to_uniform_sphere(sampler.next_2d());
+    let disc = sky.radius * warp::square_to_concentric_disk(sampler.next_2d());
+    let frame = ShadingFrame::from_normal(towards_sky);
+    let origin = sky.center + sky.radius * towards_sky + frame.to_world(DVec3::new(disc.x, disc.y, 0.0));
+    let disc_pdf = 1.0 / (PI * sky.radius * sky.radius);
+    if select_probability <= 0.0 || !disc_pdf.is_finite() {
+        return None;
+    }
+    let flux = sky.radiance / (select_probability * warp::UNIFORM_SPHERE_PDF * disc_pdf);
+    Some(Photon {
+        ray: Ray::new(origin, -towards_sky),
+        flux,
+    })
+}
+
+/// Draws one photon from the scene's emissive shapes and sky (see
+/// [`PhotonSources`]; build those once per pass when emitting many).
+pub fn emit(scene: &Scene, sampler: &mut Sampler) -> Option<Photon> {
+    PhotonSources::new(scene).emit(scene, sampler)
 }
 
 /// Follows `photon` for up to `max_depth` surface hits, calling
@@ -177,6 +276,42 @@ mod tests {
         // Light choice is the only random factor in the flux (cos/p_dir is
         // constant). Blue varies most: a two-point variable with relative
         // σ ≈ 0.84 per photon, so ≈ 0.6% over 20 000 photons; allow 5σ = 3%.
+        for c in 0..3 {
+            assert!((mean[c] / expected[c] - 1.0).abs() < 0.03, "{mean} vs {expected}");
+        }
+    }
+
+    /// With a sky as well, the mean flux per photon is the shapes' power plus
+    /// the sky's 4π · πR² · L (R: the bounding sphere's radius), and every sky
+    /// photon starts on the bounding sphere's tangent disc, aimed into it.
+    #[test]
+    fn sky_photons_carry_the_sky_power_into_the_bounding_sphere() {
+        let text = format!("background = [0.2, 0.1, 0.05]\n{TWO_LIGHTS}");
+        let scene = scene(&text);
+        let bounds = scene.bounds();
+        let (center, radius) = (bounds.centroid(), 0.5 * bounds.extent().length());
+        let n = 40_000;
+        let mut sum = Color::ZERO;
+        let mut from_sky = 0;
+        for i in 0..n {
+            let mut sampler = Sampler::new(SamplerKind::Sobol, i, 0, 11);
+            let Some(p) = emit(&scene, &mut sampler) else { continue };
+            sum += p.flux;
+            let offset = p.ray.origin - center;
+            if offset.length() > 1.0001 * radius {
+                from_sky += 1;
+                // Outside the sphere, heading in, passing within R of the centre.
+                assert!(offset.dot(p.ray.direction) < 0.0);
+                let miss_distance = (offset - offset.dot(p.ray.direction) * p.ray.direction).length();
+                assert!(miss_distance <= radius * (1.0 + 1e-5), "{miss_distance} > {radius}");
+            }
+        }
+        let pi = std::f64::consts::PI;
+        let shapes = pi * (4.0 * pi * 0.25) * Color::new(4.0, 2.0, 1.0) + pi * 2.0 * 2.0 * Color::new(1.0, 1.0, 3.0);
+        let sky = 4.0 * pi * pi * radius * radius * Color::new(0.2, 0.1, 0.05);
+        let expected = shapes + sky;
+        let mean = sum / n as f64;
+        assert!(from_sky > n / 10, "only {from_sky} sky photons");
         for c in 0..3 {
             assert!((mean[c] / expected[c] - 1.0).abs() < 0.03, "{mean} vs {expected}");
         }
