@@ -209,11 +209,17 @@ impl SppmIntegrator {
 
     /// Step 3: traces this iteration's photons in parallel, adding to the
     /// tallies of the visible points they land near. Returns false if cancelled.
-    fn photon_pass(&self, scene: &Scene, visible: &[Option<VisiblePoint>], grid: &VisiblePointGrid, cancel: &AtomicBool) -> bool {
+    fn photon_pass(
+        &self,
+        scene: &Scene,
+        sources: &PhotonSources,
+        visible: &[Option<VisiblePoint>],
+        grid: &VisiblePointGrid,
+        cancel: &AtomicBool,
+    ) -> bool {
         let (kind, iteration, max_depth) = (self.sampler, self.iterations, self.max_depth);
         let seed = self.seed ^ PHOTON_SEED;
-        let sources = PhotonSources::new(scene);
-        let inverse_unit = 1.0 / flux_unit(&sources);
+        let inverse_unit = 1.0 / flux_unit(sources);
         (0..self.parameters.photons_per_iteration)
             .into_par_iter()
             .with_min_len(64)
@@ -247,9 +253,9 @@ impl SppmIntegrator {
     }
 
     /// Step 4: folds each pixel's tally into its statistics.
-    fn update_statistics(&mut self, scene: &Scene, visible: &[Option<VisiblePoint>]) {
+    fn update_statistics(&mut self, sources: &PhotonSources, visible: &[Option<VisiblePoint>]) {
         let alpha = self.parameters.alpha;
-        let unit = flux_unit(&PhotonSources::new(scene));
+        let unit = flux_unit(sources);
         let rejected = AtomicU64::new(0);
         self.pixels
             .par_iter_mut()
@@ -289,12 +295,13 @@ impl Integrator for SppmIntegrator {
             .collect();
         let grid = VisiblePointGrid::build(&points);
         let photons_start = Instant::now();
-        if !self.photon_pass(scene, &visible, &grid, cancel) {
+        let sources = PhotonSources::new(scene);
+        if !self.photon_pass(scene, &sources, &visible, &grid, cancel) {
             self.clear_tallies();
             return false;
         }
         self.photon_time += photons_start.elapsed();
-        self.update_statistics(scene, &visible);
+        self.update_statistics(&sources, &visible);
         self.iterations += 1;
         self.total_time += start.elapsed();
         true

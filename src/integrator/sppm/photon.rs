@@ -143,12 +143,6 @@ fn emit_from_sky(sky: &Sky, select_probability: f64, sampler: &mut Sampler) -> O
     })
 }
 
-/// Draws one photon from the scene's emissive shapes and sky (see
-/// [`PhotonSources`]; build those once per pass when emitting many).
-pub fn emit(scene: &Scene, sampler: &mut Sampler) -> Option<Photon> {
-    PhotonSources::new(scene).emit(scene, sampler)
-}
-
 /// Follows `photon` for up to `max_depth` surface hits, calling
 /// `deposit(hit, towards_light, flux)` at each non-specular one, where
 /// `towards_light` is the unit direction the photon arrived from.
@@ -223,6 +217,10 @@ mod tests {
     use crate::sampler::SamplerKind;
     use crate::scene::load_scene_str;
     use std::path::Path;
+
+    fn emit(scene: &Scene, sampler: &mut Sampler) -> Option<Photon> {
+        PhotonSources::new(scene).emit(scene, sampler)
+    }
 
     fn scene(text: &str) -> Scene {
         load_scene_str(text, Path::new("<test>"), Path::new("."))
