@@ -167,15 +167,12 @@ fn curves_command(args: &BenchArgs) -> Result<()> {
             &reference,
             &configurations,
             &ladder,
-            |configuration, outcome| match outcome {
-                error_curves::CurveOutcome::Skipped(reason) => eprintln!("  {}: skipped: {reason}", configuration.name),
-                error_curves::CurveOutcome::Measured(points) => {
-                    let line: Vec<String> = points
-                        .iter()
-                        .map(|p| format!("{:.1}s:{:.4}", p.elapsed_seconds, p.metrics.rmse))
-                        .collect();
-                    eprintln!("  {:<24} RMSE {}", configuration.name, line.join(" "));
-                }
+            |configuration, points| {
+                let line: Vec<String> = points
+                    .iter()
+                    .map(|p| format!("{:.1}s:{:.4}", p.elapsed_seconds, p.metrics.rmse))
+                    .collect();
+                eprintln!("  {:<24} RMSE {}", configuration.name, line.join(" "));
             },
         )?;
         let machine = format!("before: {machine_before}; after: {}", bench::machine_note());

@@ -5,8 +5,8 @@
 //! [`scene::Scene`] (shapes, materials, lights, BVH; frozen) →
 //! an [`integrator::Integrator`] (path tracing or SPPM) rendering passes →
 //! [`film::Frame`] → image file ([`output`]), viewer texture or benchmark error.
-//! [`render::render_progressive`] is the one loop the CLI, viewer and
-//! benchmarks share.
+//! [`render::ProgressiveRender`] is the one progressive driver the CLI, the
+//! viewer and the benchmarks share.
 
 #![forbid(unsafe_code)]
 
@@ -25,4 +25,5 @@ pub mod output;
 pub mod render;
 pub mod sampler;
 pub mod scene;
+pub mod settings;
 pub mod viewer;

@@ -6,9 +6,10 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use prism::film::ToneMap;
-use prism::render::{self, IntegratorKind, RenderSettings};
+use prism::render::{IntegratorKind, ProgressiveRender, RenderSettings};
 use prism::sampler::SamplerKind;
 use prism::scene::{self, LoadedScene};
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::AtomicBool;
@@ -225,17 +226,21 @@ fn render_command(args: RenderArgs) -> Result<()> {
     let pixels = settings.pixel_count() as f64;
     let cancel = AtomicBool::new(false);
     let started = std::time::Instant::now();
-    let integrator = pool.install(|| {
-        render::render_progressive(&loaded.scene, &loaded.camera, &settings, &cancel, |integrator, progress| {
+    let mut render = ProgressiveRender::new(&settings);
+    pool.install(|| {
+        render.run(&loaded.scene, &loaded.camera, &cancel, |render| {
+            let progress = render.progress();
             let rate = pixels * progress.passes as f64 / progress.elapsed.as_secs_f64().max(1e-9);
             match settings.time_limit {
                 Some(_) => bar.set_position(progress.elapsed.as_millis() as u64),
                 None => bar.set_position(progress.passes as u64),
             }
-            let status = integrator.status();
+            let status = render.integrator().status();
             bar.set_message(format!("{} passes, {:.2} Msamples/s {status}", progress.passes, rate / 1e6));
+            ControlFlow::Continue(())
         })
     });
+    let integrator = render.integrator();
     bar.finish_and_clear();
 
     let frame = integrator.frame();

@@ -7,8 +7,9 @@ use prism::film::Frame;
 use prism::integrator::sppm::SppmIntegrator;
 use prism::integrator::{Integrator, path::PathIntegrator};
 use prism::metrics::rmse;
-use prism::render::{IntegratorKind, RenderSettings, render_progressive};
+use prism::render::{IntegratorKind, ProgressiveRender, RenderSettings, render_to_completion};
 use prism::scene::{LoadedScene, load_scene_str};
+use std::ops::ControlFlow;
 use std::path::Path;
 use std::sync::OnceLock;
 use std::sync::atomic::AtomicBool;
@@ -126,10 +127,12 @@ fn sppm_snapshots() -> &'static Vec<(u32, Frame)> {
         let settings = settings(IntegratorKind::Sppm, SPPM_ITERATIONS);
         let mut snapshots = Vec::new();
         let cancel = AtomicBool::new(false);
-        render_progressive(&loaded.scene, &loaded.camera, &settings, &cancel, |integrator, progress| {
-            if progress.passes.is_power_of_two() {
-                snapshots.push((progress.passes, integrator.frame()));
+        ProgressiveRender::new(&settings).run(&loaded.scene, &loaded.camera, &cancel, |render| {
+            let passes = render.progress().passes;
+            if passes.is_power_of_two() {
+                snapshots.push((passes, render.integrator().frame()));
             }
+            ControlFlow::Continue(())
         });
         snapshots
     })
@@ -335,8 +338,7 @@ fn the_sky_lights_a_diffuse_sphere_through_photons() {
     settings.sppm.photons_per_iteration = 20_000;
     settings.samples_per_pixel = Some(32);
     settings.seed = 3;
-    let cancel = AtomicBool::new(false);
-    let sppm = render_progressive(&loaded.scene, &loaded.camera, &settings, &cancel, |_, _| {});
+    let sppm = render_to_completion(&loaded.scene, &loaded.camera, &settings);
     let means = sppm.frame().channel_means();
     // The view (half-angle 15°, inside the sphere's 19.5°) holds a cap of
     // about 30% of the sphere, and a third of the 32 × 20 000 photons reach

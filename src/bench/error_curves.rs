@@ -13,15 +13,15 @@ use super::plot::{LinePlot, Series};
 use super::{BenchError, Csv, format_number};
 use crate::camera::Camera;
 use crate::film::{Frame, ToneMap};
-use crate::integrator;
 use crate::output::save_frame;
-use crate::render::render_progressive;
-use crate::render::settings::{IntegratorKind, RenderSettings};
+use crate::render::{ProgressiveRender, render_to_completion};
 use crate::sampler::SamplerKind;
 use crate::scene::{LoadedScene, Scene};
+use crate::settings::{IntegratorKind, RenderSettings};
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// The ε of relMSE.
 pub const RELATIVE_MSE_EPSILON: f64 = 0.01;
@@ -143,21 +143,6 @@ pub struct CurvePoint {
     pub rejected_samples: u64,
 }
 
-/// What a configuration produced.
-#[derive(Clone, Debug)]
-pub enum CurveOutcome {
-    Measured(Vec<CurvePoint>),
-    /// Not run, and why (e.g. SPPM is not built yet and `create` fell back).
-    Skipped(String),
-}
-
-/// Whether an integrator made for SPPM really is SPPM: until it exists,
-/// `integrator::create` falls back to path tracing, whose status is empty
-/// (or only reports adaptive sampling).
-fn is_fallback(kind: IntegratorKind, status: &str) -> bool {
-    kind == IntegratorKind::Sppm && (status.is_empty() || status.starts_with("adaptive"))
-}
-
 /// Renders with `settings` until the last rung of `ladder` and measures the
 /// error against `reference` at each rung. Runs on the current rayon pool.
 pub fn measure_curve(
@@ -166,30 +151,33 @@ pub fn measure_curve(
     settings: &RenderSettings,
     reference: &Frame,
     ladder: &[f64],
-) -> Result<CurveOutcome, BenchError> {
-    let mut integrator = integrator::create(settings);
+) -> Result<Vec<CurvePoint>, BenchError> {
+    // No target: the ladder ends the render.
+    let mut render = ProgressiveRender::new(&RenderSettings {
+        samples_per_pixel: None,
+        time_limit: None,
+        ..settings.clone()
+    });
     let cancel = AtomicBool::new(false);
     let mut points = Vec::with_capacity(ladder.len());
-    let mut render_seconds = 0.0;
     let mut next = 0;
-    while next < ladder.len() {
-        let start = Instant::now();
-        integrator.render_pass(scene, camera, &cancel);
-        render_seconds += start.elapsed().as_secs_f64();
-        if integrator.passes() == 1 && is_fallback(settings.integrator, &integrator.status()) {
-            return Ok(CurveOutcome::Skipped(format!(
-                "{} is not available yet (integrator::create fell back to path tracing)",
-                settings.integrator
-            )));
-        }
+    let mut failure = None;
+    render.run(scene, camera, &cancel, |render| {
+        let integrator = render.integrator();
+        let render_seconds = render.progress().elapsed.as_secs_f64();
         // Once adaptive sampling has stopped every pixel the estimate is
         // final: the remaining rungs get it, at the time actually spent.
         let converged = integrator.converged();
         if render_seconds < ladder[next] && !converged {
-            continue;
+            return ControlFlow::Continue(());
         }
-        let frame = integrator.frame();
-        let metrics = error_metrics(&frame, reference)?;
+        let metrics = match error_metrics(&integrator.frame(), reference) {
+            Ok(metrics) => metrics,
+            Err(error) => {
+                failure = Some(error);
+                return ControlFlow::Break(());
+            }
+        };
         let status = integrator.status();
         // One slow pass can cross several rungs; each gets the same estimate.
         while next < ladder.len() && (render_seconds >= ladder[next] || converged) {
@@ -203,8 +191,16 @@ pub fn measure_curve(
             });
             next += 1;
         }
+        if next < ladder.len() {
+            ControlFlow::Continue(())
+        } else {
+            ControlFlow::Break(())
+        }
+    });
+    if let Some(error) = failure {
+        return Err(error);
     }
-    Ok(CurveOutcome::Measured(points))
+    Ok(points)
 }
 
 /// Where the small reference of a scene file lives: `<directory>/<stem>.exr`.
@@ -239,8 +235,7 @@ pub const REFERENCE_SEED: u64 = 0x0005_EED0_F2EF;
 /// Renders a reference for `loaded` and writes it as EXR at `path`, with how
 /// it was made in the file's metadata; returns the passes rendered.
 pub fn make_reference(loaded: &LoadedScene, settings: &RenderSettings, path: &Path) -> Result<u32, BenchError> {
-    let cancel = AtomicBool::new(false);
-    let integrator = render_progressive(&loaded.scene, &loaded.camera, settings, &cancel, |_, _| {});
+    let integrator = render_to_completion(&loaded.scene, &loaded.camera, settings);
     let metadata = vec![
         ("Software".to_string(), format!("prism {}", env!("CARGO_PKG_VERSION"))),
         (
@@ -268,7 +263,7 @@ pub struct SceneCurves {
     pub scene: String,
     pub width: u32,
     pub height: u32,
-    pub curves: Vec<(Configuration, CurveOutcome)>,
+    pub curves: Vec<(Configuration, Vec<CurvePoint>)>,
 }
 
 /// Measures every configuration on one scene at the reference's resolution,
@@ -279,14 +274,14 @@ pub fn measure_scene(
     reference: &Frame,
     configurations: &[Configuration],
     ladder: &[f64],
-    mut progress: impl FnMut(&Configuration, &CurveOutcome),
+    mut progress: impl FnMut(&Configuration, &[CurvePoint]),
 ) -> Result<SceneCurves, BenchError> {
     let mut curves = Vec::new();
     for configuration in configurations {
         let settings = configuration.apply(&loaded.settings, reference.width, reference.height);
-        let outcome = measure_curve(&loaded.scene, &loaded.camera, &settings, reference, ladder)?;
-        progress(configuration, &outcome);
-        curves.push((configuration.clone(), outcome));
+        let points = measure_curve(&loaded.scene, &loaded.camera, &settings, reference, ladder)?;
+        progress(configuration, &points);
+        curves.push((configuration.clone(), points));
     }
     Ok(SceneCurves {
         scene: scene_name.to_string(),
@@ -321,30 +316,25 @@ impl SceneCurves {
             self.width, self.height
         ));
         csv.comments.push(machine.to_string());
-        for (configuration, outcome) in &self.curves {
-            match outcome {
-                CurveOutcome::Skipped(reason) => csv.comments.push(format!("skipped {}: {reason}", configuration.name)),
-                CurveOutcome::Measured(points) => {
-                    for p in points {
-                        csv.rows.push(vec![
-                            self.scene.clone(),
-                            configuration.name.clone(),
-                            configuration.integrator.to_string(),
-                            configuration.sampler.to_string(),
-                            configuration.adaptive_threshold.map_or(String::new(), |t| t.to_string()),
-                            format!("{}", p.target_seconds),
-                            format!("{:.4}", p.elapsed_seconds),
-                            p.passes.to_string(),
-                            format_number(p.metrics.rmse),
-                            format_number(p.metrics.relative_mse),
-                            format_number(p.metrics.bias[0]),
-                            format_number(p.metrics.bias[1]),
-                            format_number(p.metrics.bias[2]),
-                            p.rejected_samples.to_string(),
-                            p.status.replace(',', ";"),
-                        ]);
-                    }
-                }
+        for (configuration, points) in &self.curves {
+            for p in points {
+                csv.rows.push(vec![
+                    self.scene.clone(),
+                    configuration.name.clone(),
+                    configuration.integrator.to_string(),
+                    configuration.sampler.to_string(),
+                    configuration.adaptive_threshold.map_or(String::new(), |t| t.to_string()),
+                    format!("{}", p.target_seconds),
+                    format!("{:.4}", p.elapsed_seconds),
+                    p.passes.to_string(),
+                    format_number(p.metrics.rmse),
+                    format_number(p.metrics.relative_mse),
+                    format_number(p.metrics.bias[0]),
+                    format_number(p.metrics.bias[1]),
+                    format_number(p.metrics.bias[2]),
+                    p.rejected_samples.to_string(),
+                    p.status.replace(',', ";"),
+                ]);
             }
         }
         csv
@@ -355,13 +345,10 @@ impl SceneCurves {
         let mut series: Vec<Series> = self
             .curves
             .iter()
-            .filter_map(|(configuration, outcome)| match outcome {
-                CurveOutcome::Measured(points) => Some(Series {
-                    name: configuration.name.clone(),
-                    points: points.iter().map(|p| (p.elapsed_seconds, p.metrics.rmse)).collect(),
-                    guide: false,
-                }),
-                CurveOutcome::Skipped(_) => None,
+            .map(|(configuration, points)| Series {
+                name: configuration.name.clone(),
+                points: points.iter().map(|p| (p.elapsed_seconds, p.metrics.rmse)).collect(),
+                guide: false,
             })
             .collect();
         // Guide: the Monte Carlo rate, RMSE ∝ t^(-1/2), through the first curve's start.
@@ -418,12 +405,5 @@ mod tests {
     fn ladder_doubles_up_to_the_last_rung() {
         assert_eq!(time_ladder(0.5, 8.0), vec![0.5, 1.0, 2.0, 4.0, 8.0]);
         assert_eq!(time_ladder(1.0, 64.0).len(), 7);
-    }
-
-    #[test]
-    fn fallback_is_detected_only_for_sppm() {
-        assert!(is_fallback(IntegratorKind::Sppm, ""));
-        assert!(!is_fallback(IntegratorKind::Sppm, "radius 0.01"));
-        assert!(!is_fallback(IntegratorKind::PathTracing, ""));
     }
 }

@@ -13,16 +13,15 @@ use crate::accel::Bvh;
 use crate::camera::Camera;
 use crate::color::Color;
 use crate::geometry::{Mesh, Shape};
-use crate::integrator;
 use crate::material::{Material, Texture};
 use crate::math::{Aabb, Ray};
-use crate::render::settings::RenderSettings;
+use crate::render::render_to_completion;
 use crate::sampler::{Sampler, SamplerKind};
 use crate::scene::{Primitive, Scene};
+use crate::settings::RenderSettings;
 use glam::DVec3;
 use std::f64::consts::PI;
 use std::path::Path;
-use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 /// A closed, consistently outward-wound UV sphere with about `target_triangles`
@@ -201,14 +200,8 @@ pub fn measure_render(
                 time_limit: None,
                 ..settings.clone()
             };
-            let mut integrator = integrator::create(&settings);
-            let cancel = AtomicBool::new(false);
             let start = Instant::now();
-            pool.install(|| {
-                for _ in 0..passes {
-                    integrator.render_pass(scene, camera, &cancel);
-                }
-            });
+            pool.install(|| render_to_completion(scene, camera, &settings));
             let seconds = start.elapsed().as_secs_f64();
             let row = RenderRow {
                 width,

@@ -24,14 +24,13 @@ use super::scaling::{mesh_scene, sphere_mesh};
 use super::{BenchError, Csv};
 use crate::camera::Camera;
 use crate::geometry::{Mesh, SurfaceHit, Transform};
-use crate::integrator;
 use crate::math::{Frame as LocalFrame, Ray, warp};
-use crate::render::settings::{IntegratorKind, RenderSettings};
+use crate::render::render_to_completion;
 use crate::sampler::{Sampler, SamplerKind};
 use crate::scene::{LoadedScene, Scene, load_scene_str};
+use crate::settings::{IntegratorKind, RenderSettings, SppmSettings};
 use glam::DVec3;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::AtomicBool;
 
 /// A re-hit of the same primitive nearer than this fraction of its size is a self-intersection.
 pub const SELF_HIT_FRACTION: f64 = 1e-6;
@@ -376,32 +375,26 @@ pub fn stress_scenes() -> Vec<(&'static str, String)> {
     ]
 }
 
-/// Renders `passes` passes and returns (samples, rejected NaN/inf samples),
-/// or `None` when `kind` is not available (SPPM before it lands).
-pub fn rejected_samples(loaded: &LoadedScene, kind: IntegratorKind, options: &StressOptions) -> Option<(u64, u64)> {
+/// Renders `passes` passes and returns (samples, rejected NaN/inf samples).
+pub fn rejected_samples(loaded: &LoadedScene, kind: IntegratorKind, options: &StressOptions) -> (u64, u64) {
     let settings = RenderSettings {
         width: options.width,
         height: options.height,
         integrator: kind,
         samples_per_pixel: Some(options.passes),
-        sppm: crate::render::settings::SppmSettings {
+        time_limit: None,
+        adaptive_threshold: None,
+        sppm: SppmSettings {
             photons_per_iteration: options.photons_per_iteration,
             ..loaded.settings.sppm
         },
         ..loaded.settings.clone()
     };
-    let mut integrator = integrator::create(&settings);
-    let cancel = AtomicBool::new(false);
-    for pass in 0..options.passes {
-        integrator.render_pass(&loaded.scene, &loaded.camera, &cancel);
-        if pass == 0 && kind == IntegratorKind::Sppm && integrator.status().is_empty() {
-            return None;
-        }
-    }
-    Some((
-        options.passes as u64 * settings.pixel_count() as u64,
+    let integrator = render_to_completion(&loaded.scene, &loaded.camera, &settings);
+    (
+        integrator.passes() as u64 * settings.pixel_count() as u64,
         integrator.rejected_samples(),
-    ))
+    )
 }
 
 /// Random walks from the camera (a primary ray through a uniform point of
@@ -556,15 +549,14 @@ pub fn run(options: &StressOptions, mut progress: impl FnMut(&StressRow)) -> Res
     for (name, text) in stress_scenes() {
         let loaded = load_scene_str(&text, Path::new(name), Path::new("."))?;
         for kind in IntegratorKind::ALL {
-            if let Some((samples, rejected)) = rejected_samples(&loaded, kind, options) {
-                let row = StressRow {
-                    scene: name.into(),
-                    check: format!("NaN/inf samples ({kind})"),
-                    tested: samples,
-                    failures: rejected,
-                };
-                push(row, &mut rows);
-            }
+            let (samples, rejected) = rejected_samples(&loaded, kind, options);
+            let row = StressRow {
+                scene: name.into(),
+                check: format!("NaN/inf samples ({kind})"),
+                tested: samples,
+                failures: rejected,
+            };
+            push(row, &mut rows);
         }
         let (spawned, self_hits) = self_intersections(&loaded.scene, &loaded.camera, options.rays);
         push(

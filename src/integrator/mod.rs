@@ -1,14 +1,22 @@
 //! Integrators: how light transport is estimated. Each one renders
 //! progressive passes into its own state and hands out `Frame`s, so nothing
-//! downstream (viewer, CLI, benchmarks) branches on the algorithm.
+//! downstream (viewer, CLI, benchmarks) branches on the algorithm: what a
+//! view needs from a particular integrator (SPPM's gather radii, a cheaper
+//! preview) comes through the [`Integrator`] trait.
+//!
+//! - [`pass`]: the parallel pixel loop that per-pixel integrators share,
+//!   with adaptive sampling;
+//! - [`path`]: path tracing with light sampling and MIS, or BSDF sampling only;
+//! - [`sppm`]: stochastic progressive photon mapping.
 
+pub mod pass;
 pub mod path;
 pub mod sppm;
 
 use crate::camera::Camera;
 use crate::film::Frame;
-use crate::render::settings::RenderSettings;
 use crate::scene::Scene;
+use crate::settings::{IntegratorKind, RenderSettings};
 use std::sync::atomic::AtomicBool;
 
 /// A progressive renderer of one image.
@@ -23,6 +31,11 @@ pub trait Integrator: Send {
 
     /// The current estimate.
     fn frame(&self) -> Frame;
+
+    /// A fresh integrator of the same kind for an image `divisor` times
+    /// smaller on each axis, costing about 1/`divisor`² of a pass: the
+    /// coarse previews a viewer shows right after a change.
+    fn preview(&self, divisor: u32) -> Box<dyn Integrator>;
 
     /// Samples that were NaN or infinite and were dropped (must stay 0).
     fn rejected_samples(&self) -> u64 {
@@ -40,13 +53,28 @@ pub trait Integrator: Send {
     fn status(&self) -> String {
         String::new()
     }
+
+    /// Per-pixel gather radius (row-major, 0 where none yet) for integrators
+    /// that estimate density within a radius; `None` for the others.
+    fn gather_radii(&self) -> Option<Vec<f32>> {
+        None
+    }
 }
 
 /// The integrator the settings ask for.
 pub fn create(settings: &RenderSettings) -> Box<dyn Integrator> {
-    use crate::render::settings::IntegratorKind;
     match settings.integrator {
         IntegratorKind::PathTracing | IntegratorKind::BsdfOnly => Box::new(path::PathIntegrator::new(settings)),
         IntegratorKind::Sppm => Box::new(sppm::SppmIntegrator::new(settings)),
+    }
+}
+
+/// `settings` for an image `divisor` times smaller on each axis (at least one pixel).
+pub fn reduced_resolution(settings: &RenderSettings, divisor: u32) -> RenderSettings {
+    let divisor = divisor.max(1);
+    RenderSettings {
+        width: (settings.width / divisor).max(1),
+        height: (settings.height / divisor).max(1),
+        ..settings.clone()
     }
 }

@@ -14,17 +14,17 @@
 //! sampling changes keep it and its BVH); the thread is joined in `Drop`.
 //! Nothing here knows about any UI toolkit.
 
+use super::progressive::{Progress, ProgressiveRender};
 use crate::camera::Camera;
 use crate::film::Frame;
-use crate::integrator::sppm::SppmIntegrator;
-use crate::integrator::{self, Integrator};
-use crate::render::{IntegratorKind, Progress, RenderSettings};
+use crate::integrator;
 use crate::scene::Scene;
+use crate::settings::RenderSettings;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, Sender};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::thread::JoinHandle;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// After a restart, one pass is rendered at each of these fractions of the
 /// resolution before accumulation starts at full resolution: 1/8 costs 1/64
@@ -109,17 +109,19 @@ pub struct RenderStats {
 }
 
 impl RenderStats {
+    /// Where the render stands, as the progressive driver reports it.
+    pub fn progress(&self) -> Progress {
+        Progress {
+            passes: self.passes,
+            target_passes: self.target_passes,
+            elapsed: self.elapsed,
+            time_limit: self.time_limit,
+        }
+    }
+
     /// Estimated time until the sample target or the time limit, whichever comes first.
     pub fn remaining(&self) -> Option<Duration> {
-        let by_passes = self.target_passes.filter(|_| self.passes > 0).map(|target| {
-            let per_pass = self.elapsed.as_secs_f64() / self.passes as f64;
-            Duration::from_secs_f64(per_pass * target.saturating_sub(self.passes) as f64)
-        });
-        let by_time = self.time_limit.map(|limit| limit.saturating_sub(self.elapsed));
-        match (by_passes, by_time) {
-            (Some(a), Some(b)) => Some(a.min(b)),
-            (a, b) => a.or(b),
-        }
+        self.progress().remaining()
     }
 }
 
@@ -154,43 +156,6 @@ pub struct Published {
 
 /// Called by the render thread when something new was published.
 pub type Wake = Box<dyn Fn() + Send>;
-
-/// The integrator of the current generation. SPPM is held by its concrete
-/// type so the viewer can also show its per-pixel gather radii.
-enum Accumulator {
-    Any(Box<dyn Integrator>),
-    Sppm(Box<SppmIntegrator>),
-}
-
-impl Accumulator {
-    fn new(settings: &RenderSettings) -> Self {
-        match settings.integrator {
-            IntegratorKind::Sppm => Accumulator::Sppm(Box::new(SppmIntegrator::new(settings))),
-            _ => Accumulator::Any(integrator::create(settings)),
-        }
-    }
-
-    fn get(&self) -> &dyn Integrator {
-        match self {
-            Accumulator::Any(integrator) => integrator.as_ref(),
-            Accumulator::Sppm(integrator) => integrator.as_ref(),
-        }
-    }
-
-    fn get_mut(&mut self) -> &mut dyn Integrator {
-        match self {
-            Accumulator::Any(integrator) => integrator.as_mut(),
-            Accumulator::Sppm(integrator) => integrator.as_mut(),
-        }
-    }
-
-    fn radii(&self) -> Option<Vec<f32>> {
-        match self {
-            Accumulator::Any(_) => None,
-            Accumulator::Sppm(integrator) => Some(integrator.radii()),
-        }
-    }
-}
 
 /// Owner's handle on the render thread.
 pub struct RenderSession {
@@ -234,8 +199,7 @@ impl RenderSession {
             settings,
             generation: 0,
             mode: SessionState::Idle,
-            integrator: None,
-            elapsed: Duration::ZERO,
+            render: None,
             sequence: 0,
         };
         let thread = std::thread::Builder::new()
@@ -340,9 +304,7 @@ struct Worker {
     generation: u64,
     mode: SessionState,
     /// `None` until the first pass of a generation.
-    integrator: Option<Accumulator>,
-    /// Render time of this generation.
-    elapsed: Duration,
+    render: Option<ProgressiveRender>,
     sequence: u64,
 }
 
@@ -413,7 +375,7 @@ impl Worker {
                     SessionState::Idle | SessionState::Rendering => {}
                 },
                 Command::Stop => {
-                    self.integrator = None;
+                    self.render = None;
                     self.mode = SessionState::Stopped;
                 }
                 Command::Restart => restart = true,
@@ -421,8 +383,7 @@ impl Worker {
             }
         }
         if restart {
-            self.integrator = None;
-            self.elapsed = Duration::ZERO;
+            self.render = None;
             // A change made while paused or stopped is shown at once: it renders.
             self.mode = SessionState::Rendering;
         }
@@ -433,64 +394,59 @@ impl Worker {
         let (Some(scene), Some(camera)) = (self.scene.clone(), self.camera) else {
             return;
         };
-        let first_pass = self.integrator.is_none();
-        if first_pass {
+        if self.render.is_none() {
+            let render = ProgressiveRender::new(&self.settings);
             for divisor in PREVIEW_DIVISORS {
-                self.render_preview(&scene, &camera, divisor);
+                self.render_preview(render.integrator(), &scene, &camera, divisor);
                 if self.cancel.load(Ordering::Relaxed) {
                     return;
                 }
             }
+            self.render = Some(render);
         }
-        let settings = &self.settings;
-        let accumulator = self.integrator.get_or_insert_with(|| Accumulator::new(settings));
-        let start = Instant::now();
+        let Some(render) = self.render.as_mut() else { return };
         let cancel = &self.cancel;
-        let completed = self
-            .pool
-            .install(|| accumulator.get_mut().render_pass(&scene, &camera, cancel));
+        let completed = self.pool.install(|| render.step(&scene, &camera, cancel));
         if !completed {
             // Whatever aborted the pass is in the queue; its state is unspecified.
-            self.integrator = None;
+            self.render = None;
             return;
         }
-        self.elapsed += start.elapsed();
-        let radii = accumulator.radii();
-        let integrator = accumulator.get();
-        let progress = Progress {
-            passes: integrator.passes(),
-            target_passes: settings.samples_per_pixel,
-            elapsed: self.elapsed,
-            time_limit: settings.time_limit,
-        };
-        if progress.finished() || integrator.converged() {
+        if render.is_finished() {
             self.mode = SessionState::Finished;
         }
-        let frame = integrator.frame();
+        let integrator = render.integrator();
+        let (frame, radii) = (integrator.frame(), integrator.gather_radii());
         self.publish(Some(frame), radii, false);
     }
 
     /// One pass at 1/`divisor` of the resolution, published as a stand-in
     /// until the first full pass lands; skipped if it would be tiny.
-    fn render_preview(&mut self, scene: &Scene, camera: &Camera, divisor: u32) {
-        let mut settings = self.settings.clone();
-        settings.width = (settings.width / divisor).max(1);
-        settings.height = (settings.height / divisor).max(1);
-        if settings.pixel_count() < PREVIEW_MIN_PIXELS {
+    fn render_preview(&mut self, full: &dyn integrator::Integrator, scene: &Scene, camera: &Camera, divisor: u32) {
+        let preview_pixels = (self.settings.width / divisor).max(1) as usize * (self.settings.height / divisor).max(1) as usize;
+        if preview_pixels < PREVIEW_MIN_PIXELS {
             return;
         }
-        // An SPPM iteration costs its photons whatever the resolution: scale them with the pixels.
-        settings.sppm.photons_per_iteration = (settings.sppm.photons_per_iteration / (divisor * divisor)).max(1000);
-        let mut preview = integrator::create(&settings);
+        let mut preview = full.preview(divisor);
         let cancel = &self.cancel;
         if self.pool.install(|| preview.render_pass(scene, camera, cancel)) {
             self.publish(Some(preview.frame()), None, true);
         }
     }
 
+    /// Render time of this generation, pauses excluded.
+    fn elapsed(&self) -> Duration {
+        self.render
+            .as_ref()
+            .map_or(Duration::ZERO, |render| render.progress().elapsed)
+    }
+
     fn stats(&self) -> RenderStats {
-        let (passes, status, rejected) = match self.integrator.as_ref().map(Accumulator::get) {
-            Some(integrator) => (integrator.passes(), integrator.status(), integrator.rejected_samples()),
+        let (passes, status, rejected) = match &self.render {
+            Some(render) => {
+                let integrator = render.integrator();
+                (integrator.passes(), integrator.status(), integrator.rejected_samples())
+            }
             None => (0, String::new(), 0),
         };
         let samples = passes as f64 * self.settings.pixel_count() as f64;
@@ -499,9 +455,9 @@ impl Worker {
             state: self.mode,
             passes,
             target_passes: self.settings.samples_per_pixel,
-            elapsed: self.elapsed,
+            elapsed: self.elapsed(),
             time_limit: self.settings.time_limit,
-            samples_per_second: samples / self.elapsed.as_secs_f64().max(1e-9),
+            samples_per_second: samples / self.elapsed().as_secs_f64().max(1e-9),
             integrator_status: status,
             rejected_samples: rejected,
             camera: self.camera,
@@ -525,7 +481,7 @@ impl Worker {
                     camera,
                     settings,
                     passes: if preview { 0 } else { stats.passes },
-                    elapsed: self.elapsed,
+                    elapsed: self.elapsed(),
                     preview,
                     radii: radii.map(Arc::new),
                 })
@@ -552,6 +508,7 @@ mod tests {
     use super::*;
     use crate::scene::{DEFAULT_SCENE, load_scene_str};
     use std::path::Path;
+    use std::time::Instant;
 
     fn session_on_default_scene(samples: Option<u32>) -> (RenderSession, Camera) {
         let loaded = load_scene_str(DEFAULT_SCENE, Path::new("cornell"), Path::new(".")).expect("default scene");

@@ -1,8 +1,8 @@
 //! The scene file as plain data: what the user wrote, with source spans, before
 //! anything is validated or built. Documented key by key in docs/scene-format.md.
 
-use crate::render::settings::IntegratorKind;
 use crate::sampler::SamplerKind;
+use crate::settings::IntegratorKind;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use toml::Spanned;

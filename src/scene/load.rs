@@ -10,7 +10,7 @@ use crate::geometry::{AxisBox, Mesh, Quad, Revolution, Shape, Sphere, Transform}
 use crate::material::Material;
 use crate::material::texture::ImageCache;
 use crate::math::Aabb;
-use crate::render::settings::RenderSettings;
+use crate::settings::RenderSettings;
 use glam::{DAffine3, DVec2, DVec3};
 use std::collections::HashMap;
 use std::ops::Range;

@@ -22,17 +22,20 @@
 
 pub mod grid;
 pub mod photon;
+pub mod settings;
 pub mod statistics;
 pub mod visible_point;
+
+pub use settings::SppmSettings;
 
 use super::Integrator;
 use super::path::camera_ray;
 use crate::camera::Camera;
 use crate::film::Frame;
 use crate::math::DVec3;
-use crate::render::settings::{RenderSettings, SppmSettings};
 use crate::sampler::{Sampler, SamplerKind};
 use crate::scene::Scene;
+use crate::settings::RenderSettings;
 use grid::VisiblePointGrid;
 use photon::PhotonSources;
 use rayon::prelude::*;
@@ -97,6 +100,7 @@ impl InitialRadius {
 
 /// Progressive SPPM into per-pixel statistics.
 pub struct SppmIntegrator {
+    settings: RenderSettings,
     parameters: SppmSettings,
     max_depth: u32,
     sampler: SamplerKind,
@@ -115,6 +119,7 @@ impl SppmIntegrator {
     pub fn new(settings: &RenderSettings) -> Self {
         let count = settings.pixel_count();
         Self {
+            settings: settings.clone(),
             parameters: settings.sppm,
             max_depth: settings.max_depth,
             sampler: settings.sampler,
@@ -327,6 +332,18 @@ impl Integrator for SppmIntegrator {
 
     fn rejected_samples(&self) -> u64 {
         self.rejected
+    }
+
+    /// An iteration costs its photons whatever the resolution, so a preview
+    /// scales them with the pixels (keeping at least a thousand).
+    fn preview(&self, divisor: u32) -> Box<dyn Integrator> {
+        let mut settings = super::reduced_resolution(&self.settings, divisor);
+        settings.sppm.photons_per_iteration = (settings.sppm.photons_per_iteration / (divisor * divisor).max(1)).max(1000);
+        Box::new(Self::new(&settings))
+    }
+
+    fn gather_radii(&self) -> Option<Vec<f32>> {
+        Some(self.radii())
     }
 
     fn status(&self) -> String {

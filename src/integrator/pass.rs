@@ -97,8 +97,9 @@ fn add_finite(pixel: &mut PixelAccumulator, value: Color, rejected: &mut u64) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::{RenderSettings, render_with_threads};
+    use crate::render::render_with_threads;
     use crate::scene::{DEFAULT_SCENE, load_scene_str};
+    use crate::settings::RenderSettings;
     use std::path::Path;
 
     /// A pixel whose samples never vary converges exactly at the minimum

@@ -1,6 +1,11 @@
-//! What a render is asked to do. Every field here is a *sampling* parameter:
-//! changing one restarts accumulation but keeps the scene and its BVH.
+//! What a render is asked to do: plain data at the bottom of the layers,
+//! read by the scene loader, the integrators, the progressive driver and the
+//! viewer alike. Every field is a *sampling* parameter: changing one restarts
+//! accumulation but keeps the scene and its BVH. Settings that only one
+//! integrator reads are defined beside it (as plain data with no imports of
+//! their own) and gathered here.
 
+pub use crate::integrator::sppm::settings::SppmSettings;
 use crate::sampler::SamplerKind;
 use serde::{Deserialize, Serialize};
 use std::time::Duration;
@@ -37,26 +42,6 @@ impl std::fmt::Display for IntegratorKind {
     }
 }
 
-/// Parameters of stochastic progressive photon mapping.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SppmSettings {
-    pub photons_per_iteration: u32,
-    /// Initial gather radius in scene units; `None` picks it from the pixel footprint.
-    pub initial_radius: Option<f64>,
-    /// Fraction of new photons kept per iteration (Hachisuka & Jensen 2009), in (0, 1).
-    pub alpha: f64,
-}
-
-impl Default for SppmSettings {
-    fn default() -> Self {
-        Self {
-            photons_per_iteration: 200_000,
-            initial_radius: None,
-            alpha: 2.0 / 3.0,
-        }
-    }
-}
-
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
     pub width: u32,
@@ -70,7 +55,7 @@ pub struct RenderSettings {
     pub seed: u64,
     pub sppm: SppmSettings,
     /// Adaptive sampling: a pixel stops receiving samples once its relative
-    /// standard error falls below this (see `render::pass::ADAPTIVE_*`);
+    /// standard error falls below this (see `integrator::pass::ADAPTIVE_*`);
     /// `None` samples every pixel every pass.
     pub adaptive_threshold: Option<f64>,
 }

@@ -1,0 +1,113 @@
+//! Path tracing as a progressive integrator: one sample per pixel per pass
+//! through the shared pixel loop ([`super::pass`]); the per-sample tracer is
+//! in [`tracer`].
+
+pub mod tracer;
+
+pub use tracer::PathTracer;
+
+use super::{Integrator, pass};
+use crate::camera::Camera;
+use crate::film::{Film, Frame};
+use crate::math::Ray;
+use crate::sampler::{Sampler, SamplerKind};
+use crate::scene::Scene;
+use crate::settings::RenderSettings;
+use glam::DVec2;
+use rayon::prelude::*;
+use std::sync::atomic::AtomicBool;
+
+/// Progressive path tracing into a film, one sample per pixel per pass.
+pub struct PathIntegrator {
+    settings: RenderSettings,
+    tracer: PathTracer,
+    sampler: SamplerKind,
+    seed: u64,
+    film: Film,
+    passes: u32,
+    adaptive_threshold: Option<f64>,
+    /// Every pixel has met the adaptive threshold (see `Integrator::converged`).
+    converged: bool,
+}
+
+impl PathIntegrator {
+    pub fn new(settings: &RenderSettings) -> Self {
+        Self {
+            settings: settings.clone(),
+            tracer: PathTracer::from_settings(settings),
+            sampler: settings.sampler,
+            seed: settings.seed,
+            film: Film::new(settings.width, settings.height),
+            passes: 0,
+            adaptive_threshold: settings.adaptive_threshold,
+            converged: false,
+        }
+    }
+
+    pub fn film(&self) -> &Film {
+        &self.film
+    }
+}
+
+/// The camera ray of one pixel sample; consumes the sampler's first two
+/// dimensions (film position within the pixel: a box filter, and lens).
+pub fn camera_ray(camera: &Camera, (width, height): (u32, u32), x: u32, y: u32, sampler: &mut Sampler) -> Ray {
+    let jitter = sampler.next_2d();
+    let lens = sampler.next_2d();
+    let film_point = DVec2::new((x as f64 + jitter.x) / width as f64, (y as f64 + jitter.y) / height as f64);
+    camera.generate_ray(film_point, width as f64 / height as f64, lens)
+}
+
+impl Integrator for PathIntegrator {
+    fn render_pass(&mut self, scene: &Scene, camera: &Camera, cancel: &AtomicBool) -> bool {
+        let sample_index = self.passes;
+        let (tracer, kind, seed) = (self.tracer, self.sampler, self.seed);
+        let size = (self.film.width, self.film.height);
+        let completed = pass::add_samples_adaptive(&mut self.film, cancel, self.adaptive_threshold, |x, y| {
+            let mut sampler = Sampler::new(kind, y as u64 * size.0 as u64 + x as u64, sample_index, seed);
+            let ray = camera_ray(camera, size, x, y, &mut sampler);
+            tracer.radiance(scene, ray, &mut sampler)
+        });
+        if completed {
+            self.passes += 1;
+            // A stopped pixel stays stopped (its state no longer changes), so
+            // once all are, every later pass would be empty.
+            self.converged = self
+                .adaptive_threshold
+                .is_some_and(|threshold| self.film.pixels.par_iter().all(|p| pass::is_converged(p, threshold)));
+        }
+        completed
+    }
+
+    fn converged(&self) -> bool {
+        self.converged
+    }
+
+    fn preview(&self, divisor: u32) -> Box<dyn Integrator> {
+        Box::new(Self::new(&super::reduced_resolution(&self.settings, divisor)))
+    }
+
+    fn passes(&self) -> u32 {
+        self.passes
+    }
+
+    fn frame(&self) -> Frame {
+        self.film.frame()
+    }
+
+    fn rejected_samples(&self) -> u64 {
+        self.film.rejected_samples
+    }
+
+    fn status(&self) -> String {
+        match self.adaptive_threshold {
+            Some(_) if self.converged => "adaptive: converged, 0% of pixels active".to_string(),
+            Some(threshold) => {
+                let converged = self.film.pixels.iter().filter(|p| pass::is_converged(p, threshold)).count();
+                let active = 100.0 * (1.0 - converged as f64 / self.film.pixels.len().max(1) as f64);
+                format!("adaptive: {active:.0}% of pixels active")
+            }
+            None => String::new(),
+        }
+    }
+}
