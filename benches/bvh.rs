@@ -3,6 +3,7 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::DVec3;
+use prism::accel::BuildPrimitive;
 use prism::geometry::{Mesh, Shape, Transform};
 use prism::material::{Material, Texture};
 use prism::math::{Aabb, Ray};
@@ -57,7 +58,13 @@ fn incoherent_rays(bounds: Aabb, count: usize) -> Vec<Ray> {
 
 fn benchmarks(c: &mut Criterion) {
     let (primitives, mesh) = bunny();
-    let bounds: Vec<Aabb> = primitives.iter().map(|p| p.shape.bounds()).collect();
+    let bounds: Vec<BuildPrimitive> = primitives
+        .iter()
+        .map(|p| BuildPrimitive {
+            bounds: p.shape.bounds(),
+            kind: 0,
+        })
+        .collect();
 
     let mut group = c.benchmark_group("bvh_build_bunny");
     group.throughput(Throughput::Elements(bounds.len() as u64));

@@ -4,7 +4,7 @@
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use prism::bench::{self, error_curves, scaling, stress};
+use prism::bench::{self, error_curves, rays, scaling, stress, throughput};
 use prism::output::load_frame;
 use prism::scene::{self, LoadedScene};
 use std::path::{Path, PathBuf};
@@ -49,6 +49,23 @@ pub struct BenchArgs {
     /// Run the long numerical stress test instead.
     #[arg(long)]
     stress: bool,
+    /// Measure the ray core instead: closest-hit and occlusion queries on the
+    /// bunny and its subdivisions, build time and memory.
+    #[arg(long)]
+    rays: bool,
+    /// With --rays: also write meshes, rays and Prism's answers to this folder
+    /// for a peer renderer to trace (benches/peers/embree_rays.py).
+    #[arg(long, value_name = "DIR")]
+    export_rays: Option<PathBuf>,
+    /// Measure samples per second of each scene on 1 and 2 threads instead.
+    #[arg(long)]
+    throughput: bool,
+    /// Seconds of rendering per scene and thread count in --throughput.
+    #[arg(long, default_value_t = 5.0)]
+    throughput_seconds: f64,
+    /// Timed repetitions per measurement in --rays (the best is kept).
+    #[arg(long, default_value_t = 3)]
+    repetitions: usize,
     /// Passes per integrator and scene in --stress.
     #[arg(long, default_value_t = 64)]
     stress_passes: u32,
@@ -66,7 +83,11 @@ pub fn bench_command(args: BenchArgs) -> Result<()> {
         .build()
         .context("cannot start worker threads")?;
     pool.install(|| {
-        if args.stress {
+        if args.rays {
+            rays_command(&args)
+        } else if args.throughput {
+            throughput_command(&args)
+        } else if args.stress {
             stress_command(&args)
         } else if args.scaling {
             scaling_command(&args)
@@ -233,6 +254,47 @@ fn scaling_command(args: &BenchArgs) -> Result<()> {
         "wrote bvh_scaling.csv, bvh_build.png, ray_cost.png, render_scaling.csv, render_scaling.png in {}",
         args.output_dir.display()
     );
+    Ok(())
+}
+
+fn rays_command(args: &BenchArgs) -> Result<()> {
+    let bunny_path = PathBuf::from("assets/bunny.obj");
+    let bunny = prism::geometry::Mesh::load_obj(&bunny_path, &prism::geometry::Transform::default())
+        .map_err(|e| anyhow::anyhow!("{}: {e}", bunny_path.display()))?;
+    let meshes = rays::benchmark_meshes(bunny);
+    if let Some(directory) = &args.export_rays {
+        rays::export(&meshes, directory)?;
+        eprintln!("wrote meshes, rays and Prism's answers to {}", directory.display());
+    }
+    let (builds, rows) = rays::measure(&meshes, args.repetitions.max(1), |line| eprintln!("{line}"))?;
+    rays::write_results(&builds, &rows, &bench::machine_note(), &args.output_dir)?;
+    eprintln!("wrote rays.csv, rays_build.csv and rays.png in {}", args.output_dir.display());
+    Ok(())
+}
+
+fn throughput_command(args: &BenchArgs) -> Result<()> {
+    if !(args.throughput_seconds.is_finite() && args.throughput_seconds > 0.0) {
+        bail!("--throughput-seconds must be a positive number");
+    }
+    let mut rows = Vec::new();
+    for file in scene_files(args)? {
+        let name = stem(&file);
+        let loaded = scene::load_scene_file(&file)?;
+        for row in throughput::measure_scene(&name, &loaded, args.throughput_seconds, &[1, 2])? {
+            eprintln!(
+                "{:<10} {:<7} {} thread(s): {:>6.3} Msamples/s{}",
+                row.scene,
+                row.integrator.to_string(),
+                row.threads,
+                row.samples_per_second / 1e6,
+                row.photons_per_second
+                    .map_or(String::new(), |p| format!(", {:.3} Mphotons/s", p / 1e6))
+            );
+            rows.push(row);
+        }
+    }
+    throughput::write_results(&rows, &bench::machine_note(), &args.output_dir)?;
+    eprintln!("wrote throughput.csv in {}", args.output_dir.display());
     Ok(())
 }
 

@@ -77,5 +77,5 @@ fn the_leak_count_catches_a_hole() {
     let (tested, leaked) = stress::leaks(&mesh, Some(DVec3::ZERO), 4000);
     assert!(leaked > 0, "an open mesh did not leak ({tested} rays)");
     // The scene helper builds a BVH over every remaining face.
-    assert_eq!(mesh_scene(mesh).primitives.len(), keep);
+    assert_eq!(mesh_scene(mesh).primitive_count(), keep);
 }

@@ -1,7 +1,13 @@
-//! Acceleration structures. The BVH knows only bounding boxes; what a leaf
-//! primitive is, and how to hit it, is the caller's closure.
+//! Acceleration structures. The BVH knows only bounding boxes and leaf
+//! ranges; what a leaf's primitives are, and how to hit them, is the
+//! caller's closure.
+//!
+//! - [`build`]: the binned-SAH binary tree builder;
+//! - [`bvh`]: the four-wide tree collapsed from it, and its traversal;
+//! - [`bounds`]: the outward-rounded single-precision boxes both use.
 
+pub mod bounds;
+pub mod build;
 pub mod bvh;
-mod sah;
 
-pub use bvh::Bvh;
+pub use bvh::{BuildPrimitive, Bvh, Leaf, TraversalRay};

@@ -8,12 +8,17 @@
 //!   time against resolution and thread count;
 //! - [`stress`]: extreme scenes, counting NaN samples, self-intersections and
 //!   leaks through closed surfaces;
+//! - [`rays`]: the ray core alone (closest hit and occlusion, coherent and
+//!   incoherent rays, build time and memory) on the bunny and its subdivisions;
+//! - [`throughput`]: samples per second of each scene on one and two threads;
 //! - [`plot`]: the line plots.
 
 pub mod error_curves;
 pub mod plot;
+pub mod rays;
 pub mod scaling;
 pub mod stress;
+pub mod throughput;
 
 use std::io::Write;
 use std::path::Path;

@@ -9,12 +9,12 @@
 
 use super::plot::{LinePlot, Series};
 use super::{BenchError, Csv, format_number};
-use crate::accel::Bvh;
+use crate::accel::{BuildPrimitive, Bvh};
 use crate::camera::Camera;
 use crate::color::Color;
 use crate::geometry::{Mesh, Shape};
 use crate::material::{Material, Texture};
-use crate::math::{Aabb, Ray};
+use crate::math::Ray;
 use crate::render::render_to_completion;
 use crate::sampler::{Sampler, SamplerKind};
 use crate::scene::{Primitive, Scene};
@@ -112,7 +112,12 @@ pub fn measure_bvh(triangle_counts: &[u32], rays: u64, mut progress: impl FnMut(
     let mut rows = Vec::new();
     for &target in triangle_counts {
         let scene = mesh_scene(sphere_mesh(target, DVec3::ZERO, 1.0));
-        let bounds: Vec<Aabb> = scene.primitives.iter().map(|p| p.shape.bounds()).collect();
+        let bounds: Vec<BuildPrimitive> = (0..scene.primitive_count() as u32)
+            .map(|primitive| BuildPrimitive {
+                bounds: scene.primitive_bounds(primitive),
+                kind: 0,
+            })
+            .collect();
         // Repeat small builds so the total spans ~0.3 s or more: the CPU
         // clock advances in scheduler ticks (a few ms), too coarse for one build.
         let repetitions = (3_000_000 / bounds.len().max(1)).clamp(1, 3000);

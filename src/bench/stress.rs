@@ -431,7 +431,7 @@ pub fn self_intersections_with(
             let Some(next) = scene.intersect(&ray, f64::INFINITY) else {
                 break;
             };
-            let size = scene.primitives[hit.primitive as usize].shape.bounds().extent().length();
+            let size = scene.primitive_bounds(hit.primitive).extent().length();
             if next.primitive == hit.primitive && next.hit.t < SELF_HIT_FRACTION * size {
                 self_hits += 1;
             }

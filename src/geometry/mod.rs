@@ -1,6 +1,12 @@
 //! Shapes: the closed set of surfaces a ray can hit, dispatched by `match`
 //! (no virtual call per ray). Every shape answers the same questions:
-//! nearest hit (distance, normals, uv), bounds, area, and uniform area sampling.
+//! nearest hit (distance, normals, uv), bounds, area, uniform area sampling,
+//! and sampling as seen from a reference point, with its density per unit
+//! solid angle (pbrt-v4's `Shape::Sample(ctx, u)` and `PDF(ctx, wi)`):
+//! lights only choose and weight, the shape knows its own best sampling.
+//!
+//! The scene stores triangles apart from this enum, in the BVH's leaf order
+//! ([`triangles`]); `Shape::Triangle` describes one on its way there.
 
 pub mod axis_box;
 pub mod bezier;
@@ -8,21 +14,24 @@ pub mod hit;
 pub mod mesh;
 pub mod quad;
 pub mod revolution;
+pub mod sampling;
 pub mod sphere;
 pub mod transform;
 pub mod triangle;
+pub mod triangles;
 
 pub use axis_box::AxisBox;
 pub use hit::{AreaSample, SurfaceHit};
 pub use mesh::Mesh;
 pub use quad::Quad;
 pub use revolution::Revolution;
+pub use sampling::ShapeSample;
 pub use sphere::Sphere;
 pub use transform::Transform;
 pub use triangle::Triangle;
 
 use crate::math::{Aabb, Ray};
-use glam::DVec2;
+use glam::{DVec2, DVec3};
 
 /// One intersectable surface.
 #[derive(Clone, Debug)]
@@ -91,6 +100,25 @@ impl Shape {
             Shape::AxisBox(b) => b.sample_area(u),
             Shape::Quad(q) => q.sample_area(u),
             Shape::Revolution(r) => r.sample_area(u),
+        }
+    }
+
+    /// A point on the surface as seen from `reference`, with its density
+    /// per unit solid angle there: spheres sample the cone they subtend,
+    /// every other shape its area.
+    pub fn sample_from(&self, reference: DVec3, u: DVec2) -> Option<ShapeSample> {
+        match self {
+            Shape::Sphere(s) => s.sample_from(reference, u),
+            _ => sampling::by_area(self.sample_area(u), self.area(), reference),
+        }
+    }
+
+    /// The solid-angle density with which [`Shape::sample_from`] at
+    /// `reference` would produce the surface point `point` (normal `normal`).
+    pub fn pdf_from(&self, reference: DVec3, point: DVec3, normal: DVec3) -> f64 {
+        match self {
+            Shape::Sphere(s) => s.pdf_from(reference, point, normal),
+            _ => sampling::pdf_by_area(self.area(), reference, point, normal),
         }
     }
 }

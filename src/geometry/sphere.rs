@@ -2,7 +2,8 @@
 //! (Ray Tracing Gems, ch. 7) so that smallpt's radius-1e5 walls stay exact.
 
 use super::hit::{AreaSample, SurfaceHit};
-use crate::math::{Aabb, Ray, gamma, warp};
+use super::sampling::{self, ShapeSample};
+use crate::math::{Aabb, Frame, Ray, gamma, warp};
 use glam::{DVec2, DVec3};
 use std::f64::consts::PI;
 
@@ -76,6 +77,59 @@ impl Sphere {
         let u = 0.5 + longitude / (2.0 * PI);
         let v = direction.y.clamp(-1.0, 1.0).acos() / PI;
         DVec2::new(u, v)
+    }
+
+    /// A point as seen from `reference`: from outside, a uniform direction
+    /// in the cone the sphere subtends (pbrt-v3 §14.2.2), mapped to the
+    /// visible surface point it passes through; from inside, a uniform
+    /// point on the area.
+    pub fn sample_from(&self, reference: DVec3, u: DVec2) -> Option<ShapeSample> {
+        if !self.is_outside(reference) {
+            return sampling::by_area(self.sample_area(u), self.area(), reference);
+        }
+        let distance_squared = (self.center - reference).length_squared();
+        let distance = distance_squared.sqrt();
+        let cos_max = self.cone_cos_max(reference);
+        let (cos_theta, phi) = warp::square_to_uniform_cone_angles(u, cos_max);
+        let sin2_theta = (1.0 - cos_theta * cos_theta).max(0.0);
+        // Angle α at the centre between the axis and the surface point
+        // (law of cosines on the triangle reference–centre–point).
+        let radius_squared = self.radius * self.radius;
+        let hit_distance = distance * cos_theta - (radius_squared - distance_squared * sin2_theta).max(0.0).sqrt();
+        let cos_alpha =
+            ((distance_squared + radius_squared - hit_distance * hit_distance) / (2.0 * distance * self.radius)).clamp(-1.0, 1.0);
+        let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
+        let frame = Frame::from_normal((reference - self.center) / distance);
+        let normal = frame.to_world(DVec3::new(sin_alpha * phi.cos(), sin_alpha * phi.sin(), cos_alpha));
+        let point = self.center + self.radius * normal;
+        let pdf = warp::uniform_cone_pdf(cos_max);
+        (pdf.is_finite() && cos_max < 1.0).then_some(ShapeSample {
+            point,
+            point_error: gamma(5) * (point.abs() + self.center.abs()),
+            normal,
+            pdf,
+        })
+    }
+
+    /// The solid-angle density of [`Sphere::sample_from`] at `reference`
+    /// for the surface point `point` with normal `normal`.
+    pub fn pdf_from(&self, reference: DVec3, point: DVec3, normal: DVec3) -> f64 {
+        if self.is_outside(reference) {
+            warp::uniform_cone_pdf(self.cone_cos_max(reference))
+        } else {
+            sampling::pdf_by_area(self.area(), reference, point, normal)
+        }
+    }
+
+    /// Whether cone sampling applies: `reference` lies (safely) outside.
+    fn is_outside(&self, reference: DVec3) -> bool {
+        (reference - self.center).length_squared() > self.radius * self.radius * (1.0 + 1e-9)
+    }
+
+    /// cos θmax of the cone the sphere subtends at `reference` (outside).
+    fn cone_cos_max(&self, reference: DVec3) -> f64 {
+        let sin2_max = self.radius * self.radius / (reference - self.center).length_squared();
+        (1.0 - sin2_max).max(0.0).sqrt()
     }
 
     /// Uniform point on the surface; density `1 / area`.

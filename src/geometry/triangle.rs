@@ -3,11 +3,13 @@
 
 use super::hit::{AreaSample, SurfaceHit};
 use super::mesh::Mesh;
+use super::sampling::{self, ShapeSample};
 use crate::math::{Aabb, Ray, gamma, warp};
 use glam::{DVec2, DVec3};
 
-/// One face of a mesh. Positions are copied here so the hot loop touches
-/// one cache line; shading attributes stay in the mesh.
+/// One face of a mesh, in double precision: for area, sampling and the hit
+/// record. (The BVH's leaves keep the same vertices in a compact form: see
+/// `triangles.rs`.)
 #[derive(Clone, Copy, Debug)]
 pub struct Triangle {
     pub vertices: [DVec3; 3],
@@ -22,45 +24,50 @@ pub struct TriangleHit {
     pub barycentric: [f64; 3],
 }
 
-impl Triangle {
-    pub fn bounds(&self) -> Aabb {
-        Aabb::from_points(&self.vertices)
-    }
+/// The per-ray part of the watertight test, computed once per ray and
+/// shared by every triangle it meets: the axis permutation that makes the
+/// direction's largest component z, and the shear that aligns it with +z
+/// (Woop, Benthin & Wald 2013, §3).
+#[derive(Clone, Copy, Debug)]
+pub struct TriangleRay {
+    /// Source axes of the permuted x, y and z.
+    axes: [usize; 3],
+    /// The origin, permuted.
+    origin: [f64; 3],
+    shear_x: f64,
+    shear_y: f64,
+    shear_z: f64,
+}
 
-    pub fn area(&self) -> f64 {
-        let [a, b, c] = self.vertices;
-        0.5 * (b - a).cross(c - a).length()
-    }
-
-    /// Unnormalised face normal, by the counter-clockwise winding.
-    pub fn face_normal(&self) -> DVec3 {
-        let [a, b, c] = self.vertices;
-        (b - a).cross(c - a)
-    }
-
-    /// Watertight hit test in `(0, t_max)`.
-    #[inline]
-    pub fn intersect_raw(&self, ray: &Ray, t_max: f64) -> Option<TriangleHit> {
+impl TriangleRay {
+    pub fn new(ray: &Ray) -> Self {
         let d = ray.direction;
-        // Permute axes so the ray travels along the largest component (kz).
         let kz = d.abs().max_position();
         let kx = (kz + 1) % 3;
         let ky = (kx + 1) % 3;
-        let permute = |v: DVec3| DVec3::new(v[kx], v[ky], v[kz]);
-        let dir = permute(d);
-        let shear_x = -dir.x / dir.z;
-        let shear_y = -dir.y / dir.z;
-        let shear_z = 1.0 / dir.z;
-        // Translate vertices to the ray origin, then shear so the ray is +z.
-        let transform = |v: DVec3| {
-            let v = permute(v - ray.origin);
-            DVec3::new(v.x + shear_x * v.z, v.y + shear_y * v.z, v.z)
+        Self {
+            axes: [kx, ky, kz],
+            origin: [ray.origin[kx], ray.origin[ky], ray.origin[kz]],
+            shear_x: -d[kx] / d[kz],
+            shear_y: -d[ky] / d[kz],
+            shear_z: 1.0 / d[kz],
+        }
+    }
+
+    /// Watertight hit test in `(0, t_max)` against the triangle whose
+    /// vertices are `v` (x, y, z of each). Exact sign tests on the edge
+    /// functions decide shared edges the same way for both triangles.
+    #[inline(always)]
+    pub fn intersect(&self, v: &[f64; 9], t_max: f64) -> Option<TriangleHit> {
+        let [kx, ky, kz] = self.axes;
+        // Translate vertices to the ray origin, permute, then shear so the ray is +z.
+        let transform = |i: usize| {
+            let x = v[3 * i + kx] - self.origin[0];
+            let y = v[3 * i + ky] - self.origin[1];
+            let z = v[3 * i + kz] - self.origin[2];
+            DVec3::new(x + self.shear_x * z, y + self.shear_y * z, z)
         };
-        let p = [
-            transform(self.vertices[0]),
-            transform(self.vertices[1]),
-            transform(self.vertices[2]),
-        ];
+        let p = [transform(0), transform(1), transform(2)];
         // Edge functions; exact sign at zero falls back to a tie-break in the
         // same way for both triangles sharing the edge.
         let e0 = p[1].x * p[2].y - p[1].y * p[2].x;
@@ -73,6 +80,7 @@ impl Triangle {
         if det == 0.0 {
             return None;
         }
+        let shear_z = self.shear_z;
         let z = [p[0].z * shear_z, p[1].z * shear_z, p[2].z * shear_z];
         let t_scaled = e0 * z[0] + e1 * z[1] + e2 * z[2];
         if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
@@ -102,6 +110,30 @@ impl Triangle {
             barycentric: [e0 * inverse_det, e1 * inverse_det, e2 * inverse_det],
         })
     }
+}
+
+impl Triangle {
+    pub fn bounds(&self) -> Aabb {
+        Aabb::from_points(&self.vertices)
+    }
+
+    pub fn area(&self) -> f64 {
+        let [a, b, c] = self.vertices;
+        0.5 * (b - a).cross(c - a).length()
+    }
+
+    /// Unnormalised face normal, by the counter-clockwise winding.
+    pub fn face_normal(&self) -> DVec3 {
+        let [a, b, c] = self.vertices;
+        (b - a).cross(c - a)
+    }
+
+    /// Watertight hit test in `(0, t_max)`.
+    #[inline]
+    pub fn intersect_raw(&self, ray: &Ray, t_max: f64) -> Option<TriangleHit> {
+        let [a, b, c] = self.vertices;
+        TriangleRay::new(ray).intersect(&[a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z], t_max)
+    }
 
     /// Full hit record, interpolating the mesh's normals and uv if it has them.
     pub fn surface_hit(&self, hit: &TriangleHit, mesh: &Mesh) -> SurfaceHit {
@@ -124,6 +156,16 @@ impl Triangle {
             shading_normal,
             uv,
         }
+    }
+
+    /// A uniform point on the area, as seen from `reference` (solid-angle density).
+    pub fn sample_from(&self, reference: DVec3, u: DVec2) -> Option<ShapeSample> {
+        sampling::by_area(self.sample_area(u), self.area(), reference)
+    }
+
+    /// The solid-angle density of [`Triangle::sample_from`].
+    pub fn pdf_from(&self, reference: DVec3, point: DVec3, normal: DVec3) -> f64 {
+        sampling::pdf_by_area(self.area(), reference, point, normal)
     }
 
     /// Uniform point; density `1 / area`.

@@ -10,6 +10,13 @@ pub struct Aabb {
     pub max: DVec3,
 }
 
+impl Default for Aabb {
+    /// The empty box.
+    fn default() -> Self {
+        Self::EMPTY
+    }
+}
+
 impl Aabb {
     pub const EMPTY: Aabb = Aabb {
         min: DVec3::splat(f64::INFINITY),

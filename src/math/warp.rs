@@ -42,10 +42,16 @@ pub const UNIFORM_SPHERE_PDF: f64 = 1.0 / (4.0 * PI);
 
 /// Uniform direction in the cone of half-angle `acos(cos_theta_max)` around +z.
 pub fn square_to_uniform_cone(u: DVec2, cos_theta_max: f64) -> DVec3 {
-    let cos_theta = 1.0 - u.x * (1.0 - cos_theta_max);
+    let (cos_theta, phi) = square_to_uniform_cone_angles(u, cos_theta_max);
     let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-    let phi = 2.0 * PI * u.y;
     DVec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
+}
+
+/// The polar angle's cosine and the azimuth of [`square_to_uniform_cone`]:
+/// cos θ uniform in [cos θmax, 1] (the cone's solid angle is linear in cos θ),
+/// φ uniform in [0, 2π).
+pub fn square_to_uniform_cone_angles(u: DVec2, cos_theta_max: f64) -> (f64, f64) {
+    ((1.0 - u.x) + u.x * cos_theta_max, 2.0 * PI * u.y)
 }
 
 pub fn uniform_cone_pdf(cos_theta_max: f64) -> f64 {

@@ -9,10 +9,12 @@ pub mod load;
 pub use error::SceneError;
 pub use load::{LoadedScene, load_scene_file, load_scene_str};
 
-use crate::accel::Bvh;
+use crate::accel::{BuildPrimitive, Bvh, TraversalRay};
 use crate::color::Color;
-use crate::geometry::{Mesh, Shape, SurfaceHit};
-use crate::light::{AsShape, Light, Lights};
+use crate::geometry::triangle::TriangleRay;
+use crate::geometry::triangles::{LeafHit, TriangleSource, Triangles, store_mesh_positions, stored_position};
+use crate::geometry::{Mesh, Shape, SurfaceHit, Triangle};
+use crate::light::{Emitter, EmitterSource, Light, Lights};
 use crate::material::Material;
 use crate::math::{Aabb, Ray};
 
@@ -26,12 +28,6 @@ pub struct Primitive {
     pub material: u32,
 }
 
-impl AsShape for Primitive {
-    fn shape(&self) -> &Shape {
-        &self.shape
-    }
-}
-
 /// A hit and which primitive it belongs to.
 #[derive(Clone, Copy, Debug)]
 pub struct Intersection {
@@ -39,10 +35,18 @@ pub struct Intersection {
     pub primitive: u32,
 }
 
+/// BVH leaf kinds: the scene's triangles, and its other shapes.
+const TRIANGLE_LEAF: u8 = 0;
+const SHAPE_LEAF: u8 = 1;
+
 /// Everything a ray can meet; immutable once built.
+///
+/// Primitives are numbered shapes first (spheres, boxes, quads,
+/// revolutions, in BVH leaf order), then triangles (in leaf order too).
 #[derive(Debug)]
 pub struct Scene {
-    pub primitives: Vec<Primitive>,
+    shapes: Vec<Primitive>,
+    triangles: Triangles,
     pub meshes: Vec<Mesh>,
     pub materials: Vec<Material>,
     pub lights: Lights,
@@ -52,68 +56,188 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// Builds the BVH over `primitives` (reordered to match it) and collects
-    /// the emissive ones as lights.
-    pub fn new(primitives: Vec<Primitive>, meshes: Vec<Mesh>, materials: Vec<Material>, background: Color) -> Self {
-        let bounds: Vec<Aabb> = primitives.iter().map(|p| p.shape.bounds()).collect();
-        let (bvh, order) = Bvh::build(&bounds);
-        let mut slots: Vec<Option<Primitive>> = primitives.into_iter().map(Some).collect();
-        let primitives: Vec<Primitive> = order.iter().filter_map(|&i| slots[i as usize].take()).collect();
-        let lights = primitives
+    /// Builds the BVH over `primitives` (stored in its leaf order, triangles
+    /// apart) and collects the emissive ones as lights. Mesh positions and
+    /// triangle vertices are rounded to the form the BVH stores triangles
+    /// in (single-precision offsets from an anchor per mesh, see
+    /// `geometry::triangles`); triangles that this leaves without area are
+    /// dropped, as they can never be hit.
+    pub fn new(primitives: Vec<Primitive>, mut meshes: Vec<Mesh>, materials: Vec<Material>, background: Color) -> Self {
+        let anchors: Vec<_> = meshes.iter_mut().map(store_mesh_positions).collect();
+        let mut shapes = Vec::new();
+        let mut triangles: Vec<(Triangle, u32)> = Vec::new();
+        for primitive in primitives {
+            match primitive.shape {
+                Shape::Triangle(mut triangle) => {
+                    let anchor = anchors.get(triangle.mesh as usize).copied().unwrap_or_default();
+                    triangle.vertices = triangle.vertices.map(|v| stored_position(anchor, v));
+                    if triangle.area() > 0.0 {
+                        triangles.push((triangle, primitive.material));
+                    }
+                }
+                _ => shapes.push(primitive),
+            }
+        }
+        let build_primitives: Vec<BuildPrimitive> = triangles
             .iter()
-            .enumerate()
-            .filter_map(|(i, p)| match &materials[p.material as usize] {
+            .map(|(triangle, _)| BuildPrimitive {
+                bounds: triangle.bounds(),
+                kind: TRIANGLE_LEAF,
+            })
+            .chain(shapes.iter().map(|p| BuildPrimitive {
+                bounds: p.shape.bounds(),
+                kind: SHAPE_LEAF,
+            }))
+            .collect();
+        let (bvh, orders) = Bvh::build(&build_primitives);
+        let triangle_count = triangles.len() as u32;
+        let triangles = Triangles::new(&triangles, &orders[TRIANGLE_LEAF as usize], anchors);
+        let mut slots: Vec<Option<Primitive>> = shapes.into_iter().map(Some).collect();
+        let shapes: Vec<Primitive> = orders[SHAPE_LEAF as usize]
+            .iter()
+            .filter_map(|&i| slots[(i - triangle_count) as usize].take())
+            .collect();
+        let mut scene = Self {
+            shapes,
+            triangles,
+            meshes,
+            materials,
+            lights: Lights::default(),
+            background,
+            bvh,
+        };
+        let lights: Vec<Light> = (0..scene.primitive_count() as u32)
+            .filter_map(|primitive| match scene.material_of(primitive) {
                 Material::Emissive { radiance, two_sided } if *radiance != Color::ZERO => Some(Light {
-                    primitive: i as u32,
+                    primitive,
                     radiance: *radiance,
                     two_sided: *two_sided,
                 }),
                 _ => None,
             })
             .collect();
-        let lights = Lights::new(lights, &primitives);
-        Self {
-            primitives,
-            meshes,
-            materials,
-            lights,
-            background,
-            bvh,
-        }
+        scene.lights = Lights::new(lights, &scene);
+        scene
     }
 
     pub fn bounds(&self) -> Aabb {
         self.bvh.bounds()
     }
 
-    pub fn material_of(&self, primitive: u32) -> &Material {
-        &self.materials[self.primitives[primitive as usize].material as usize]
+    /// Shapes plus triangles.
+    pub fn primitive_count(&self) -> usize {
+        self.shapes.len() + self.triangles.len()
     }
 
-    /// Nearest hit in `(0, t_max)`.
+    /// The scene's triangles, in leaf order.
+    pub fn triangles(&self) -> &Triangles {
+        &self.triangles
+    }
+
+    /// Index into `materials` of a primitive's material.
+    pub fn material_index(&self, primitive: u32) -> u32 {
+        match self.triangle_index(primitive) {
+            Some(triangle) => self.triangles.source(triangle).material,
+            None => self.shapes[primitive as usize].material,
+        }
+    }
+
+    pub fn material_of(&self, primitive: u32) -> &Material {
+        &self.materials[self.material_index(primitive) as usize]
+    }
+
+    /// Bounds of one primitive.
+    pub fn primitive_bounds(&self, primitive: u32) -> Aabb {
+        match self.triangle_index(primitive) {
+            Some(triangle) => self.triangles.get(triangle).bounds(),
+            None => self.shapes[primitive as usize].shape.bounds(),
+        }
+    }
+
+    /// Which mesh face (and material) a triangle primitive is; `None` for shapes.
+    pub fn triangle_source(&self, primitive: u32) -> Option<TriangleSource> {
+        self.triangle_index(primitive).map(|triangle| self.triangles.source(triangle))
+    }
+
+    /// The position of a triangle primitive among the triangles.
+    fn triangle_index(&self, primitive: u32) -> Option<u32> {
+        primitive.checked_sub(self.shapes.len() as u32)
+    }
+
+    /// Nearest hit in `(0, t_max)`. Triangles report only distance and
+    /// barycentrics during traversal; the hit record (normals, uv, error
+    /// bounds) is built once, for the final hit.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<Intersection> {
-        let mut best: Option<Intersection> = None;
-        self.bvh.intersect(ray, t_max, |index, t_max| {
-            let hit = self.primitives[index].shape.intersect(ray, t_max, &self.meshes)?;
-            best = Some(Intersection {
-                hit,
-                primitive: index as u32,
-            });
-            Some(hit.t)
+        let traversal = TraversalRay::new(ray);
+        let triangle_ray = TriangleRay::new(ray);
+        let mut nearest_triangle: Option<LeafHit> = None;
+        let mut nearest_shape: Option<Intersection> = None;
+        let mut t = t_max;
+        self.bvh.traverse(&traversal, &mut t, |leaf, t_max| {
+            if leaf.kind == TRIANGLE_LEAF {
+                if let Some(found) = self.triangles.intersect_leaf(&triangle_ray, leaf.first, leaf.count, *t_max) {
+                    *t_max = found.hit.t;
+                    nearest_triangle = Some(found);
+                    nearest_shape = None;
+                }
+            } else {
+                for index in leaf.first..leaf.first + leaf.count {
+                    if let Some(hit) = self.shapes[index as usize].shape.intersect(ray, *t_max, &self.meshes) {
+                        *t_max = hit.t;
+                        nearest_shape = Some(Intersection { hit, primitive: index });
+                        nearest_triangle = None;
+                    }
+                }
+            }
+            false
         });
-        best
+        if let Some(found) = nearest_triangle {
+            let triangle = self.triangles.get(found.index);
+            let mesh = &self.meshes[triangle.mesh as usize];
+            return Some(Intersection {
+                hit: triangle.surface_hit(&found.hit, mesh),
+                primitive: self.shapes.len() as u32 + found.index,
+            });
+        }
+        nearest_shape
     }
 
-    /// Whether anything lies on the ray before `t_max` (shadow rays).
+    /// Whether anything lies on the ray before `t_max` (shadow rays); stops
+    /// at the first hit found.
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f64) -> bool {
-        self.bvh.occluded(ray, t_max, |index, t_max| {
-            self.primitives[index].shape.hit_distance(ray, t_max).is_some()
-        })
+        let traversal = TraversalRay::new(ray);
+        let triangle_ray = TriangleRay::new(ray);
+        let mut t = t_max;
+        let mut found = false;
+        self.bvh.traverse(&traversal, &mut t, |leaf, t_max| {
+            found = if leaf.kind == TRIANGLE_LEAF {
+                self.triangles.occludes_leaf(&triangle_ray, leaf.first, leaf.count, *t_max)
+            } else {
+                (leaf.first..leaf.first + leaf.count)
+                    .any(|index| self.shapes[index as usize].shape.hit_distance(ray, *t_max).is_some())
+            };
+            found
+        });
+        found
     }
 
     pub fn bvh(&self) -> &Bvh {
         &self.bvh
+    }
+
+    /// Bytes of the BVH nodes plus the triangles' leaf data.
+    pub fn acceleration_bytes(&self) -> usize {
+        self.bvh.memory_bytes() + self.triangles.len() * Triangles::BYTES_PER_TRIANGLE
+    }
+}
+
+impl EmitterSource for Scene {
+    fn emitter(&self, primitive: u32) -> Emitter<'_> {
+        match self.triangle_index(primitive) {
+            Some(triangle) => Emitter::Triangle(self.triangles.get(triangle)),
+            None => Emitter::Shape(&self.shapes[primitive as usize].shape),
+        }
     }
 }

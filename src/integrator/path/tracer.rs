@@ -53,9 +53,11 @@ impl PathTracer {
             if material.emission().is_some() {
                 let emitted = material.emitted(hit.geometric_normal.dot(wo_world));
                 if emitted != Color::ZERO {
-                    let weight = match scene.lights.light_of_primitive(intersection.primitive as usize) {
+                    let weight = match scene.lights.light_of_primitive(intersection.primitive) {
                         Some(light) if light_sampling && !specular_bounce => {
-                            let light_pdf = scene.lights.pdf(&scene.primitives, light, previous_point, &hit);
+                            let light_pdf = scene
+                                .lights
+                                .pdf(scene, light, previous_point, hit.point, hit.geometric_normal);
                             power_heuristic(previous_pdf, light_pdf)
                         }
                         _ => 1.0,
@@ -78,7 +80,7 @@ impl PathTracer {
             if light_sampling && !material.is_specular() {
                 let u_select = sampler.next_1d();
                 let u_light = sampler.next_2d();
-                if let Some(light) = scene.lights.sample(&scene.primitives, hit.point, u_select, u_light) {
+                if let Some(light) = scene.lights.sample(scene, hit.point, u_select, u_light) {
                     let wi = frame.to_local(light.wi);
                     let f = material.eval(wo, wi, &at) * wi.z.abs();
                     if f != Color::ZERO {

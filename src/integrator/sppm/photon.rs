@@ -17,6 +17,7 @@
 
 use crate::color::{Color, luminance};
 use crate::geometry::SurfaceHit;
+use crate::light::EmitterSource;
 use crate::material::{ShadingPoint, Transport};
 use crate::math::{DVec3, Frame as ShadingFrame, Ray, warp};
 use crate::sampler::Sampler;
@@ -104,8 +105,8 @@ fn emit_from_shape(scene: &Scene, u_select: f64, shape_probability: f64, sampler
     let (index, light_probability) = scene.lights.choose(u_select)?;
     let select_probability = light_probability * shape_probability;
     let light = &scene.lights.lights[index as usize];
-    let shape = &scene.primitives[light.primitive as usize].shape;
-    let on_light = shape.sample_area(sampler.next_2d());
+    let emitter = scene.emitter(light.primitive);
+    let on_light = emitter.sample_area(sampler.next_2d());
     let local = warp::square_to_cosine_hemisphere(sampler.next_2d());
     let side = sampler.next_1d();
     let (normal, side_probability) = match light.two_sided {
@@ -114,7 +115,7 @@ fn emit_from_shape(scene: &Scene, u_select: f64, shape_probability: f64, sampler
         false => (on_light.normal, 1.0),
     };
     let direction_pdf = warp::cosine_hemisphere_pdf(local.z) * side_probability;
-    let area_pdf = 1.0 / shape.area();
+    let area_pdf = 1.0 / emitter.area();
     if direction_pdf <= 0.0 || !area_pdf.is_finite() || select_probability <= 0.0 {
         return None;
     }

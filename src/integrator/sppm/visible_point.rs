@@ -61,7 +61,7 @@ pub fn trace_camera_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, max
         };
         let hit = intersection.hit;
         path_length += hit.t;
-        let material_index = scene.primitives[intersection.primitive as usize].material;
+        let material_index = scene.material_index(intersection.primitive);
         let material = &scene.materials[material_index as usize];
         let wo_world = -ray.direction;
         // Every vertex here ends a purely specular chain, so emission counts in full.

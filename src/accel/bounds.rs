@@ -1,0 +1,113 @@
+//! Single-precision boxes for the BVH, rounded outward from the exact
+//! double-precision bounds of what they hold, so that a box test can only
+//! accept more than the exact test would (Ize 2013, "Robust BVH ray
+//! traversal"; pbrt-v4 §6.8.2).
+
+use crate::math::Aabb;
+
+/// An axis-aligned box in `f32`; `EMPTY` is the identity of `union`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounds32 {
+    pub min: [f32; 3],
+    pub max: [f32; 3],
+}
+
+impl Bounds32 {
+    pub const EMPTY: Bounds32 = Bounds32 {
+        min: [f32::INFINITY; 3],
+        max: [f32::NEG_INFINITY; 3],
+    };
+
+    /// The smallest `f32` box containing `aabb`.
+    pub fn enclosing(aabb: &Aabb) -> Self {
+        Self {
+            min: std::array::from_fn(|axis| round_down(aabb.min[axis])),
+            max: std::array::from_fn(|axis| round_up(aabb.max[axis])),
+        }
+    }
+
+    #[inline]
+    pub fn union(&self, other: &Bounds32) -> Self {
+        Self {
+            min: std::array::from_fn(|axis| pick_min(self.min[axis], other.min[axis])),
+            max: std::array::from_fn(|axis| pick_max(self.max[axis], other.max[axis])),
+        }
+    }
+
+    #[inline]
+    pub fn include(&self, point: [f32; 3]) -> Self {
+        Self {
+            min: std::array::from_fn(|axis| pick_min(self.min[axis], point[axis])),
+            max: std::array::from_fn(|axis| pick_max(self.max[axis], point[axis])),
+        }
+    }
+
+    /// max − min per axis (negative for an empty box).
+    pub fn extent(&self) -> [f32; 3] {
+        std::array::from_fn(|axis| self.max[axis] - self.min[axis])
+    }
+
+    /// Half the surface area: the SAH only compares areas.
+    #[inline]
+    pub fn half_area(&self) -> f32 {
+        let [x, y, z] = self.extent();
+        if x < 0.0 || y < 0.0 || z < 0.0 {
+            return 0.0;
+        }
+        x * y + y * z + z * x
+    }
+
+    pub fn contains(&self, other: &Bounds32) -> bool {
+        (0..3).all(|axis| self.min[axis] <= other.min[axis] && other.max[axis] <= self.max[axis])
+    }
+
+    pub fn to_aabb(self) -> Aabb {
+        Aabb {
+            min: glam::DVec3::from_array(self.min.map(f64::from)),
+            max: glam::DVec3::from_array(self.max.map(f64::from)),
+        }
+    }
+}
+
+/// `a < b ? a : b`: one instruction, unlike `f32::min`'s NaN rules.
+#[inline(always)]
+fn pick_min(a: f32, b: f32) -> f32 {
+    if a < b { a } else { b }
+}
+
+#[inline(always)]
+fn pick_max(a: f32, b: f32) -> f32 {
+    if a > b { a } else { b }
+}
+
+/// The largest `f32` not above `x`.
+pub fn round_down(x: f64) -> f32 {
+    let rounded = x as f32;
+    if f64::from(rounded) > x {
+        rounded.next_down()
+    } else {
+        rounded
+    }
+}
+
+/// The smallest `f32` not below `x`.
+pub fn round_up(x: f64) -> f32 {
+    let rounded = x as f32;
+    if f64::from(rounded) < x { rounded.next_up() } else { rounded }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn outward_rounding_brackets_the_value() {
+        for x in [0.1, -0.1, 1e-30, -7.3e12, 1.0 / 3.0, 3.0, 1e300, -1e300] {
+            let (down, up) = (round_down(x), round_up(x));
+            assert!(f64::from(down) <= x && x <= f64::from(up), "{x}: {down} {up}");
+            assert!(up == down || up == down.next_up(), "{x}: one ulp apart");
+        }
+        assert_eq!(round_down(0.5), 0.5);
+        assert_eq!(round_up(0.5), 0.5);
+    }
+}
