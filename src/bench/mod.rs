@@ -1,6 +1,7 @@
 //! The library side of `prism bench`: measurements that say how fast Prism
 //! converges and how it scales, each written as CSV (with the machine load in
-//! its header, since the numbers mean little without it) and drawn as PNG.
+//! its header, since the numbers mean little without it) and drawn as PNG
+//! (with the `plots` feature).
 //!
 //! - [`error_curves`]: error against a reference image at doubling wall times,
 //!   one curve per integrator / sampler / adaptive configuration;
@@ -8,7 +9,7 @@
 //!   time against resolution and thread count;
 //! - [`stress`]: extreme scenes, counting NaN samples, self-intersections and
 //!   leaks through closed surfaces;
-//! - [`plot`]: the line plots.
+//! - [`plot`]: the line plots (drawn only with the `plots` feature).
 
 pub mod error_curves;
 pub mod plot;
