@@ -4,10 +4,13 @@
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use prism::bench::{self, error_curves, rays, scaling, stress, throughput};
+use prism::bench::{self, error_curves, plot, rays, scaling, stress, throughput};
 use prism::output::load_frame;
 use prism::scene::{self, LoadedScene};
 use std::path::{Path, PathBuf};
+
+/// Said instead of naming PNG files when the build cannot draw them.
+const PLOTS_DISABLED: &str = "plots disabled: this prism was built without the `plots` feature";
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {
@@ -16,7 +19,7 @@ pub struct BenchArgs {
     /// Directory of the small reference images (<scene stem>.exr).
     #[arg(long, default_value = "references")]
     references: PathBuf,
-    /// Where the CSV tables and PNG plots go.
+    /// Where the CSV tables and PNG plots (with the `plots` feature) go.
     #[arg(long, default_value = "docs")]
     output_dir: PathBuf,
     /// Last rung of the time ladder, in seconds of rendering.
@@ -201,7 +204,11 @@ fn curves_command(args: &BenchArgs) -> Result<()> {
         let png_path = args.output_dir.join(format!("error_{name}.png"));
         curves.csv(&machine, args.threads).write(&csv_path)?;
         curves.plot().write_png(&png_path)?;
-        eprintln!("wrote {} and {}", csv_path.display(), png_path.display());
+        if plot::ENABLED {
+            eprintln!("wrote {} and {}", csv_path.display(), png_path.display());
+        } else {
+            eprintln!("wrote {} ({PLOTS_DISABLED})", csv_path.display());
+        }
     }
     Ok(())
 }
@@ -250,10 +257,17 @@ fn scaling_command(args: &BenchArgs) -> Result<()> {
         },
     )?;
     scaling::write_render_results(&render_rows, &name, &bench::machine_note(), &args.output_dir)?;
-    eprintln!(
-        "wrote bvh_scaling.csv, bvh_build.png, ray_cost.png, render_scaling.csv, render_scaling.png in {}",
-        args.output_dir.display()
-    );
+    if plot::ENABLED {
+        eprintln!(
+            "wrote bvh_scaling.csv, bvh_build.png, ray_cost.png, render_scaling.csv, render_scaling.png in {}",
+            args.output_dir.display()
+        );
+    } else {
+        eprintln!(
+            "wrote bvh_scaling.csv and render_scaling.csv in {} ({PLOTS_DISABLED})",
+            args.output_dir.display()
+        );
+    }
     Ok(())
 }
 
@@ -268,7 +282,11 @@ fn rays_command(args: &BenchArgs) -> Result<()> {
     }
     let (builds, rows) = rays::measure(&meshes, args.repetitions.max(1), |line| eprintln!("{line}"))?;
     rays::write_results(&builds, &rows, &bench::machine_note(), &args.output_dir)?;
-    eprintln!("wrote rays.csv, rays_build.csv and rays.png in {}", args.output_dir.display());
+    if plot::ENABLED {
+        eprintln!("wrote rays.csv, rays_build.csv and rays.png in {}", args.output_dir.display());
+    } else {
+        eprintln!("wrote rays.csv and rays_build.csv in {} ({PLOTS_DISABLED})", args.output_dir.display());
+    }
     Ok(())
 }
 

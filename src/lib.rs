@@ -26,4 +26,5 @@ pub mod render;
 pub mod sampler;
 pub mod scene;
 pub mod settings;
+#[cfg(feature = "viewer")]
 pub mod viewer;

@@ -135,6 +135,7 @@ fn main() -> ExitCode {
 }
 
 /// Opens the viewer; without a display it says how to render headless instead.
+#[cfg(feature = "viewer")]
 fn view_command(scene: Option<PathBuf>) -> Result<()> {
     let start = prism::viewer::ViewerStart {
         scene,
@@ -142,6 +143,15 @@ fn view_command(scene: Option<PathBuf>) -> Result<()> {
     };
     prism::viewer::run(start)?;
     Ok(())
+}
+
+/// A headless build (without the `viewer` feature) has no viewer to open.
+#[cfg(not(feature = "viewer"))]
+fn view_command(_scene: Option<PathBuf>) -> Result<()> {
+    bail!(
+        "this prism was built without the viewer (cargo feature `viewer`); \
+         render headless with `prism render`, or rebuild with the default features to get the viewer"
+    )
 }
 
 fn load(scene: Option<&Path>) -> Result<LoadedScene> {

@@ -1,6 +1,7 @@
 //! The library side of `prism bench`: measurements that say how fast Prism
 //! converges and how it scales, each written as CSV (with the machine load in
-//! its header, since the numbers mean little without it) and drawn as PNG.
+//! its header, since the numbers mean little without it) and drawn as PNG
+//! (with the `plots` feature).
 //!
 //! - [`error_curves`]: error against a reference image at doubling wall times,
 //!   one curve per integrator / sampler / adaptive configuration;
@@ -11,7 +12,7 @@
 //! - [`rays`]: the ray core alone (closest hit and occlusion, coherent and
 //!   incoherent rays, build time and memory) on the bunny and its subdivisions;
 //! - [`throughput`]: samples per second of each scene on one and two threads;
-//! - [`plot`]: the line plots.
+//! - [`plot`]: the line plots (drawn only with the `plots` feature).
 
 pub mod error_curves;
 pub mod plot;

@@ -126,3 +126,6 @@ impl Material {
 pub fn reflect(wo: DVec3) -> DVec3 {
     DVec3::new(-wo.x, -wo.y, wo.z)
 }
+
+#[cfg(test)]
+mod sampling_tests;

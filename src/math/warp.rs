@@ -86,6 +86,7 @@ pub fn power_heuristic(pdf_a: f64, pdf_b: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::chi_square::{ChiSquareOutcome, ChiSquareTest, SphericalCap, sidak_significance};
 
     fn grid(n: usize) -> impl Iterator<Item = DVec2> {
         (0..n * n).map(move |i| DVec2::new(((i % n) as f64 + 0.5) / n as f64, ((i / n) as f64 + 0.5) / n as f64))
@@ -115,6 +116,120 @@ mod tests {
             let b = square_to_uniform_triangle(u);
             assert!(b.x >= 0.0 && b.y >= 0.0 && b.x + b.y <= 1.0 + 1e-12);
         }
+    }
+
+    /// The χ² tests of the warps below: a family of six at 1% together
+    /// (Šidák), each over 50 000 independent samples.
+    const CHI_SQUARE_TESTS: usize = 6;
+
+    fn chi_square(seed: u64, bins: (usize, usize)) -> ChiSquareTest {
+        ChiSquareTest {
+            samples: 50_000,
+            seed,
+            bins,
+        }
+    }
+
+    fn assert_accepted(name: &str, outcome: ChiSquareOutcome) {
+        let significance = sidak_significance(0.01, CHI_SQUARE_TESTS);
+        eprintln!("χ² {name}: {outcome}");
+        assert!(
+            outcome.accepts(significance),
+            "{name} rejected at {significance:.2e}: {outcome}"
+        );
+    }
+
+    /// Uniform on the unit disk: density 1/π inside, binned over [−1, 1]² so
+    /// that points outside the disk fall in bins expecting none.
+    #[test]
+    fn concentric_disk_fits_its_density() {
+        let outcome = chi_square(11, (16, 16)).planar(
+            (-1.0, 1.0),
+            (-1.0, 1.0),
+            |s| Some(square_to_concentric_disk(s.next_2d())),
+            |p| if p.length_squared() <= 1.0 { FRAC_1_PI } else { 0.0 },
+        );
+        assert_accepted("concentric disk", outcome);
+    }
+
+    /// Density cos θ / π on the upper hemisphere, binned over it (samples
+    /// below the horizon would land "elsewhere", where none are expected).
+    #[test]
+    fn cosine_hemisphere_fits_its_density() {
+        let hemisphere = SphericalCap {
+            axis: DVec3::Z,
+            cos_theta_min: 0.0,
+        };
+        let outcome = chi_square(12, (10, 20)).directions(
+            hemisphere,
+            |s| Some(square_to_cosine_hemisphere(s.next_2d())),
+            |w| cosine_hemisphere_pdf(w.z),
+        );
+        assert_accepted("cosine hemisphere", outcome);
+    }
+
+    #[test]
+    fn uniform_sphere_fits_its_density() {
+        let outcome = chi_square(13, (10, 20)).directions(
+            SphericalCap::SPHERE,
+            |s| Some(square_to_uniform_sphere(s.next_2d())),
+            |_| UNIFORM_SPHERE_PDF,
+        );
+        assert_accepted("uniform sphere", outcome);
+    }
+
+    /// A narrow cone and one wider than a hemisphere, each binned over its
+    /// own cap so that every bin has samples to compare.
+    #[test]
+    fn uniform_cones_fit_their_density() {
+        for (seed, cos_theta_max) in [(14, 0.8), (15, -0.3)] {
+            let cap = SphericalCap {
+                axis: DVec3::Z,
+                cos_theta_min: cos_theta_max,
+            };
+            let outcome = chi_square(seed, (10, 20)).directions(
+                cap,
+                |s| Some(square_to_uniform_cone(s.next_2d(), cos_theta_max)),
+                |w| {
+                    if w.z >= cos_theta_max {
+                        uniform_cone_pdf(cos_theta_max)
+                    } else {
+                        0.0
+                    }
+                },
+            );
+            assert_accepted(&format!("uniform cone, cos θmax = {cos_theta_max}"), outcome);
+        }
+    }
+
+    /// Barycentrics uniform over the triangle b₁, b₂ ≥ 0, b₁ + b₂ ≤ 1: density
+    /// 2 there (the triangle has area ½), binned over the unit square.
+    #[test]
+    fn uniform_triangle_fits_its_density() {
+        let outcome = chi_square(16, (16, 16)).planar(
+            (0.0, 1.0),
+            (0.0, 1.0),
+            |s| Some(square_to_uniform_triangle(s.next_2d())),
+            |b| if b.x + b.y <= 1.0 { 2.0 } else { 0.0 },
+        );
+        assert_accepted("uniform triangle", outcome);
+    }
+
+    /// The test can fail: cosine-weighted directions checked against the
+    /// uniform hemisphere's density 1/(2π) are rejected beyond doubt.
+    #[test]
+    fn cosine_samples_are_rejected_against_the_uniform_hemisphere_density() {
+        let hemisphere = SphericalCap {
+            axis: DVec3::Z,
+            cos_theta_min: 0.0,
+        };
+        let outcome = chi_square(12, (10, 20)).directions(
+            hemisphere,
+            |s| Some(square_to_cosine_hemisphere(s.next_2d())),
+            |_| 1.0 / (2.0 * PI),
+        );
+        eprintln!("χ² cosine samples against the uniform hemisphere: {outcome}");
+        assert!(outcome.p_value < 1e-12, "{outcome}");
     }
 
     #[test]
