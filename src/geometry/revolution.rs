@@ -16,7 +16,7 @@
 //! in a rotated frame: a polynomial of degree `2n` that never divides by `D_z`.
 //!
 //! Roots are isolated by Bernstein subdivision with Descartes' rule of signs
-//! (`bezier::isolate_roots`). The factors `a` and `x` (degree `n`) are
+//! (`roots::isolate_roots`). The factors `a` and `x` (degree `n`) are
 //! subdivided, not `F`: the coefficients of `F` on a small piece are formed
 //! from the piece's own factors, so their error is relative to the piece's
 //! size. Near-horizontal rays make `F` nearly a perfect square, `a² ≈ D_z² x²`,
@@ -70,10 +70,10 @@
 //! does not find its own origin. Rays that pass within about `1e-15 ×` the
 //! object's size of tangency may be reported as hit or miss.
 
-use crate::geometry::bezier::{
-    self, BernsteinPiece, IsolatedRoot, MAX_COEFFICIENTS, MAX_CONTROL_POINTS, PolynomialPiece, binomial_row,
-};
+use crate::geometry::bezier::{self, MAX_CONTROL_POINTS};
 use crate::geometry::hit::{AreaSample, SurfaceHit};
+use crate::math::bernstein::{self, MAX_COEFFICIENTS, binomial_row};
+use crate::math::roots::{self, BernsteinPiece, IsolatedRoot, PolynomialPiece};
 use crate::math::{Aabb, Ray, gamma};
 use glam::{DAffine3, DMat3, DVec2, DVec3};
 use std::cell::Cell;
@@ -627,7 +627,7 @@ impl Segment {
             }
             let error = gamma(2) * (self.height_size + origin_z.abs());
             let piece = BernsteinPiece::new(&height[..=n], error);
-            bezier::isolate_roots(
+            roots::isolate_roots(
                 &piece,
                 0.0,
                 1.0,
@@ -688,7 +688,7 @@ impl Segment {
                 + dz.abs() * ray.frame_error,
         };
         let mut skip = |piece: &RayProfilePiece<N>| piece.nearest_parameter(ray) > cutoff.get();
-        bezier::isolate_roots(
+        roots::isolate_roots(
             &piece,
             0.0,
             1.0,
@@ -702,7 +702,7 @@ impl Segment {
                     + gamma(n as u32 + 4) * (self.height_size + origin_z.abs()))
                     / dz.abs();
                 // Radial formula, its branch from the sign of a/D_z.
-                let (a_value, a_slope) = bezier::bernstein_evaluate_with_derivative(&piece.a[..piece.count], root.tau);
+                let (a_value, a_slope) = bernstein::evaluate_with_derivative(&piece.a[..piece.count], root.tau);
                 let a_largest = piece.a_range.0.abs().max(piece.a_range.1.abs());
                 let a_error = piece.a_error + gamma(n as u32 + 2) * a_largest + a_slope.abs() / piece.width * root.t_uncertainty;
                 let radial = RadialSolution::new(ray, point.x, derivative.x, root.t_uncertainty, n);
@@ -862,7 +862,7 @@ impl<const N: usize> RayProfilePiece<N> {
     }
 
     /// `a`, `da/dτ`, `x` and `dx/dτ` at `τ`, by de Casteljau's algorithm on
-    /// both factors at once (as `bezier::bernstein_evaluate_with_derivative`).
+    /// both factors at once (as `bernstein::evaluate_with_derivative`).
     fn factors_at(&self, tau: f64) -> (f64, f64, f64, f64) {
         let count = self.count.min(N);
         if count < 2 {
@@ -994,7 +994,7 @@ impl<const N: usize> PolynomialPiece for RayProfilePiece<N> {
         let mut left = *self;
         let mut right = *self;
         let count = self.count.min(N);
-        // de Casteljau at ½ on both factors (as `bezier::bernstein_split`):
+        // de Casteljau at ½ on both factors (as `bernstein::split`):
         // the left edge of the triangle is the left half, the right edge the
         // right half.
         let (mut a, mut x) = (self.a, self.x);
