@@ -1,13 +1,17 @@
 //! Scenes: the plain description parsed from a scene file
 //! (`description`), turned into a frozen, render-ready `Scene` (`load`)
-//! whose acceleration structure is built once and shared read-only.
+//! whose acceleration structure is built once and shared read-only. A
+//! description can be placed by a `similarity` (scaled and moved) before it
+//! is built.
 
 pub mod description;
 pub mod error;
 pub mod load;
+pub mod similarity;
 
 pub use error::SceneError;
 pub use load::{LoadedScene, load_scene_file, load_scene_str};
+pub use similarity::{Similarity, load_scene_str_placed};
 
 use crate::accel::Bvh;
 use crate::color::Color;
