@@ -4,9 +4,10 @@
 //! also gets a negative control showing it can fail.
 
 use glam::DVec3;
-use prism::bench::scaling::{mesh_scene, sphere_mesh};
+use prism::bench::scaling::sphere_mesh;
 use prism::bench::stress::{self, StressOptions};
 use prism::math::Ray;
+use prism::scene::Scene;
 use std::path::Path;
 
 fn options() -> StressOptions {
@@ -75,5 +76,5 @@ fn the_leak_count_catches_a_hole() {
     let (tested, leaked) = stress::leaks(&mesh, Some(DVec3::ZERO), 4000);
     assert!(leaked > 0, "an open mesh did not leak ({tested} rays)");
     // The scene helper builds a BVH over every remaining face.
-    assert_eq!(mesh_scene(mesh).primitives.len(), keep);
+    assert_eq!(Scene::from_mesh(mesh).primitives.len(), keep);
 }

@@ -22,7 +22,7 @@
 //! of the revolution intersector with an independent reference are counted
 //! by `tests/revolution_stress.rs`.
 
-use super::scaling::{mesh_scene, sphere_mesh};
+use super::scaling::sphere_mesh;
 use super::{BenchError, Csv};
 use crate::camera::Camera;
 use crate::geometry::{Mesh, SurfaceHit, Transform};
@@ -213,7 +213,7 @@ pub fn leaks(mesh: &Mesh, inside: Option<DVec3>, rays: u64) -> (u64, u64) {
         return (0, 0);
     }
     let extent = crate::math::Aabb::from_points(&mesh.positions).extent().length();
-    let scene = mesh_scene(mesh.clone());
+    let scene = Scene::from_mesh(mesh.clone());
     let (mut tested, mut leaked) = (0, 0);
     for i in 0..rays {
         let mut sampler = Sampler::new(SamplerKind::Random, i, 0, 13);

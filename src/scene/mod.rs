@@ -17,7 +17,7 @@ use crate::accel::Bvh;
 use crate::color::Color;
 use crate::geometry::{Mesh, Shape, SurfaceHit};
 use crate::light::{AsShape, Light, Lights};
-use crate::material::Material;
+use crate::material::{Material, Texture};
 use crate::math::{Aabb, Ray};
 
 /// The TOML text of the scene compiled into the binary.
@@ -84,6 +84,23 @@ impl Scene {
             background,
             bvh,
         }
+    }
+
+    /// A scene of one mesh, each triangle a primitive of one grey diffuse
+    /// material, with no lights and a black background: for intersection
+    /// tests and benchmarks.
+    pub fn from_mesh(mesh: Mesh) -> Self {
+        let primitives: Vec<Primitive> = mesh
+            .triangles(0)
+            .map(|t| Primitive {
+                shape: Shape::Triangle(t),
+                material: 0,
+            })
+            .collect();
+        let materials = vec![Material::Diffuse {
+            albedo: Texture::Constant(Color::splat(0.5)),
+        }];
+        Self::new(primitives, vec![mesh], materials, Color::ZERO)
     }
 
     pub fn bounds(&self) -> Aabb {
