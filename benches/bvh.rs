@@ -4,34 +4,19 @@
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::DVec3;
 use prism::accel::BuildPrimitive;
-use prism::geometry::{Mesh, Shape, Transform};
-use prism::material::{Material, Texture};
+use prism::geometry::{Mesh, Transform};
 use prism::math::{Aabb, Ray};
-use prism::scene::{Primitive, Scene};
+use prism::scene::Scene;
 use rayon::prelude::*;
 use std::hint::black_box;
 use std::path::Path;
 
-fn bunny() -> (Vec<Primitive>, Mesh) {
+fn bunny() -> Mesh {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/bunny.obj");
-    let mesh = match Mesh::load_obj(&path, &Transform::default()) {
+    match Mesh::load_obj(&path, &Transform::default()) {
         Ok(m) => m,
         Err(e) => panic!("{}: {e}", path.display()),
-    };
-    let primitives = mesh
-        .triangles(0)
-        .map(|t| Primitive {
-            shape: Shape::Triangle(t),
-            material: 0,
-        })
-        .collect();
-    (primitives, mesh)
-}
-
-fn material() -> Vec<Material> {
-    vec![Material::Diffuse {
-        albedo: Texture::Constant(DVec3::ONE),
-    }]
+    }
 }
 
 /// Rays from random points on a sphere around the bunny towards random points
@@ -57,11 +42,12 @@ fn incoherent_rays(bounds: Aabb, count: usize) -> Vec<Ray> {
 }
 
 fn benchmarks(c: &mut Criterion) {
-    let (primitives, mesh) = bunny();
-    let bounds: Vec<BuildPrimitive> = primitives
-        .iter()
-        .map(|p| BuildPrimitive {
-            bounds: p.shape.bounds(),
+    let mesh = bunny();
+    // In file order, as the scene loader hands triangles to the builder.
+    let bounds: Vec<BuildPrimitive> = mesh
+        .triangles(0)
+        .map(|t| BuildPrimitive {
+            bounds: t.bounds(),
             kind: 0,
         })
         .collect();
@@ -73,7 +59,7 @@ fn benchmarks(c: &mut Criterion) {
     });
     group.finish();
 
-    let scene = Scene::new(primitives, vec![mesh], material(), DVec3::ZERO);
+    let scene = Scene::from_mesh(mesh);
     let rays = incoherent_rays(scene.bounds(), 100_000);
     let hits = rays.iter().filter(|r| scene.intersect(r, f64::INFINITY).is_some()).count();
     eprintln!("incoherent rays: {} of {} hit the bunny", hits, rays.len());

@@ -3,10 +3,9 @@
 //! loaded machine, unlike wall time): `cargo run --release --example ray_cost -- 200000`.
 
 use glam::DVec3;
-use prism::geometry::{Mesh, Shape, Transform};
-use prism::material::{Material, Texture};
+use prism::geometry::{Mesh, Transform};
 use prism::math::Ray;
-use prism::scene::{Primitive, Scene};
+use prism::scene::Scene;
 use std::path::Path;
 
 fn main() {
@@ -19,21 +18,7 @@ fn main() {
             std::process::exit(1);
         }
     };
-    let primitives = mesh
-        .triangles(0)
-        .map(|t| Primitive {
-            shape: Shape::Triangle(t),
-            material: 0,
-        })
-        .collect();
-    let scene = Scene::new(
-        primitives,
-        vec![mesh],
-        vec![Material::Diffuse {
-            albedo: Texture::Constant(DVec3::ONE),
-        }],
-        DVec3::ZERO,
-    );
+    let scene = Scene::from_mesh(mesh);
     let bounds = scene.bounds();
     let mut state = 0x9e37_79b9_7f4a_7c15u64;
     let mut next = move || {

@@ -2,7 +2,7 @@
 //! ~10⁷ of them), sample counts and the second moment the noise estimate needs;
 //! and `Frame`, the linear snapshot that viewers, image files and benchmarks read.
 
-use crate::color::{Color, luminance, srgb_encode};
+use crate::color::{Color, luminance, srgb_encode_8bit};
 
 /// Running sums of one pixel's samples.
 #[derive(Clone, Copy, Debug, Default)]
@@ -113,7 +113,7 @@ impl Frame {
         let scale = exposure_stops.exp2();
         self.pixels
             .iter()
-            .map(|p| p.map(|c| (srgb_encode(tone_map.apply(c as f64 * scale)) * 255.0 + 0.5) as u8))
+            .map(|p| p.map(|c| srgb_encode_8bit(tone_map.apply(c as f64 * scale))))
             .collect()
     }
 

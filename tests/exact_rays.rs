@@ -19,7 +19,8 @@ use glam::DVec3;
 use num_bigint::BigInt;
 use num_traits::{Signed, Zero};
 use prism::accel::TraversalRay;
-use prism::bench::scaling::{mesh_scene, sphere_mesh};
+use prism::bench::scaling::sphere_mesh;
+use prism::scene::Scene;
 use prism::geometry::triangle::TriangleRay;
 use prism::math::Ray;
 use prism::sampler::{Sampler, SamplerKind};
@@ -247,7 +248,7 @@ impl Candidates {
 /// A closed mesh (a UV sphere: fans of thin faces meet at its poles) as
 /// the scene stores it, and its faces for the references.
 fn test_scene() -> (prism::scene::Scene, Candidates) {
-    let scene = mesh_scene(sphere_mesh(1200, DVec3::new(0.3, -0.2, 0.1), 1.7));
+    let scene = Scene::from_mesh(sphere_mesh(1200, DVec3::new(0.3, -0.2, 0.1), 1.7));
     let stored = &scene.meshes[0];
     let faces = stored.faces.iter().map(|f| f.map(|i| stored.positions[i as usize])).collect();
     (scene, Candidates::new(faces))

@@ -2,9 +2,9 @@
 //! from inside), and watertightness of a closed mesh under the BVH.
 
 use glam::{DVec2, DVec3};
-use prism::geometry::{AxisBox, Mesh, Quad, Shape, Sphere, Triangle};
+use prism::geometry::{AxisBox, Mesh, Quad, Sphere, Triangle};
 use prism::math::{Aabb, Ray};
-use prism::scene::{Primitive, Scene};
+use prism::scene::Scene;
 
 fn close(a: f64, b: f64) -> bool {
     (a - b).abs() <= 1e-9 * (1.0 + b.abs())
@@ -171,22 +171,7 @@ fn icosphere(subdivisions: u32) -> Vec<[DVec3; 3]> {
 #[test]
 fn closed_mesh_has_no_leaks_at_edges_and_vertices() {
     let triangles = icosphere(3);
-    let mesh = Mesh::from_triangles(&triangles);
-    let primitives: Vec<Primitive> = mesh
-        .triangles(0)
-        .map(|t| Primitive {
-            shape: Shape::Triangle(t),
-            material: 0,
-        })
-        .collect();
-    let scene = Scene::new(
-        primitives,
-        vec![mesh],
-        vec![prism::material::Material::Diffuse {
-            albedo: prism::material::Texture::Constant(DVec3::ONE),
-        }],
-        DVec3::ZERO,
-    );
+    let scene = Scene::from_mesh(Mesh::from_triangles(&triangles));
 
     let mut state = 0x2545_f491_4f6c_dd1du64;
     let mut next = move || {

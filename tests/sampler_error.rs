@@ -3,18 +3,8 @@
 
 mod common;
 use common::{Job, render, shipped_scene};
-use prism::film::Frame;
+use prism::metrics::rmse;
 use prism::sampler::SamplerKind;
-
-fn rmse(a: &Frame, b: &Frame) -> f64 {
-    let sum: f64 = a
-        .pixels
-        .iter()
-        .zip(&b.pixels)
-        .map(|(p, q)| (0..3).map(|c| (p[c] as f64 - q[c] as f64).powi(2)).sum::<f64>())
-        .sum();
-    (sum / (3 * a.pixels.len()) as f64).sqrt()
-}
 
 /// Reference: the average of a 1024-spp Sobol' and a 1024-spp random render
 /// (so neither sampler is favoured). Then 8 independent 16-spp renders per
@@ -68,6 +58,7 @@ fn sobol_beats_random_at_equal_samples_on_smallpt() {
                     ),
                     &reference,
                 )
+                .expect("same size")
             })
             .collect()
     };

@@ -8,90 +8,24 @@ use prism::integrator::sppm::SppmIntegrator;
 use prism::integrator::{Integrator, path::PathIntegrator};
 use prism::metrics::rmse;
 use prism::render::{IntegratorKind, ProgressiveRender, RenderSettings, render_to_completion};
-use prism::scene::{LoadedScene, load_scene_str};
+use prism::scene::{LoadedScene, load_scene_file, load_scene_str};
 use std::ops::ControlFlow;
 use std::path::Path;
 use std::sync::OnceLock;
 use std::sync::atomic::AtomicBool;
 
-/// The Cornell box with a white block instead of the mirror and glass balls:
-/// everything diffuse, so the classic SPPM split (photons for all reflected
-/// light) covers every path the path tracer samples.
-const DIFFUSE_CORNELL: &str = r#"
-[camera]
-position = [278, 273, -800]
-look_at = [278, 273, 0]
-fov_y_degrees = 39.3
-
-[render]
-width = 32
-height = 32
-max_depth = 16
-
-[materials.white]
-type = "diffuse"
-albedo = [0.73, 0.73, 0.73]
-[materials.red]
-type = "diffuse"
-albedo = [0.65, 0.05, 0.05]
-[materials.green]
-type = "diffuse"
-albedo = [0.12, 0.45, 0.15]
-[materials.light]
-type = "emissive"
-radiance = [17, 12, 4]
-
-[[objects]]
-type = "quad"
-corner = [0, 0, 0]
-edge_u = [555, 0, 0]
-edge_v = [0, 0, 555]
-material = "white"
-[[objects]]
-type = "quad"
-corner = [0, 555, 0]
-edge_u = [555, 0, 0]
-edge_v = [0, 0, 555]
-material = "white"
-[[objects]]
-type = "quad"
-corner = [0, 0, 555]
-edge_u = [555, 0, 0]
-edge_v = [0, 555, 0]
-material = "white"
-[[objects]]
-type = "quad"
-corner = [555, 0, 0]
-edge_u = [0, 555, 0]
-edge_v = [0, 0, 555]
-material = "red"
-[[objects]]
-type = "quad"
-corner = [0, 0, 0]
-edge_u = [0, 555, 0]
-edge_v = [0, 0, 555]
-material = "green"
-[[objects]]
-type = "quad"
-corner = [213, 548.7, 227]
-edge_u = [130, 0, 0]
-edge_v = [0, 0, 105]
-material = "light"
-[[objects]]
-type = "box"
-min = [290, 0, 250]
-max = [450, 300, 410]
-material = "white"
-"#;
-
 const PATH_SAMPLES: u32 = 1024;
 const SPPM_ITERATIONS: u32 = 64;
 const PHOTONS: u32 = 20_000;
 
+/// The Cornell box with a white block instead of the mirror and glass balls:
+/// everything diffuse, so the classic SPPM split (photons for all reflected
+/// light) covers every path the path tracer samples.
 fn cornell() -> &'static LoadedScene {
     static SCENE: OnceLock<LoadedScene> = OnceLock::new();
     SCENE.get_or_init(|| {
-        load_scene_str(DIFFUSE_CORNELL, Path::new("<diffuse cornell>"), Path::new(".")).expect("test scene parses")
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/diffuse-cornell.toml");
+        load_scene_file(&path).expect("tests/scenes/diffuse-cornell.toml loads")
     })
 }
 

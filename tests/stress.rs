@@ -4,10 +4,10 @@
 //! also gets a negative control showing it can fail.
 
 use glam::DVec3;
-use prism::bench::scaling::{mesh_scene, sphere_mesh};
+use prism::bench::scaling::sphere_mesh;
 use prism::bench::stress::{self, StressOptions};
 use prism::math::Ray;
-use prism::scene::load_scene_str;
+use prism::scene::Scene;
 use std::path::Path;
 
 fn options() -> StressOptions {
@@ -47,12 +47,11 @@ fn extreme_scenes_have_no_nan_samples_self_intersections_or_leaks() {
 /// (hit points there carry errors of ~1e-11 relative to 1e5 ≈ 1e-6 absolute).
 #[test]
 fn the_self_intersection_count_catches_unoffset_rays() {
-    let scenes = stress::stress_scenes();
-    let (_, text) = scenes
-        .iter()
-        .find(|(name, _)| name.starts_with("smallpt"))
+    let smallpt = stress::stress_scenes()
+        .into_iter()
+        .find(|scene| scene.name.starts_with("smallpt"))
         .expect("smallpt scene");
-    let loaded = load_scene_str(text, Path::new("smallpt"), Path::new(".")).expect("loads");
+    let loaded = smallpt.load().expect("loads");
     let (spawned, self_hits) = stress::self_intersections_with(&loaded.scene, &loaded.camera, 500, |hit, direction| {
         Ray::new(hit.point, direction)
     });
@@ -77,5 +76,5 @@ fn the_leak_count_catches_a_hole() {
     let (tested, leaked) = stress::leaks(&mesh, Some(DVec3::ZERO), 4000);
     assert!(leaked > 0, "an open mesh did not leak ({tested} rays)");
     // The scene helper builds a BVH over every remaining face.
-    assert_eq!(mesh_scene(mesh).primitive_count(), keep);
+    assert_eq!(Scene::from_mesh(mesh).primitive_count(), keep);
 }

@@ -3,16 +3,15 @@
 //! current estimate with a converged reference. Only time spent in
 //! `render_pass` is counted: measuring the error does not eat into the budget.
 //!
-//! Metrics, over all pixels and channels, with x the estimate and r the reference:
-//! RMSE = sqrt(mean (x − r)²); relMSE = mean (x − r)² / (r² + ε) with ε = 0.01
-//! (Rousselle, Knaus and Zwicker 2011, so dark pixels do not dominate); and the
-//! mean bias per channel, mean (x − r), which stays near 0 for unbiased
-//! estimators and reveals the consistent-but-biased ones (SPPM) and leaks.
+//! Metrics (`metrics::error_metrics`): RMSE, relMSE and the mean bias per
+//! channel, which stays near 0 for unbiased estimators and reveals the
+//! consistent-but-biased ones (SPPM) and leaks.
 
 use super::plot::{LinePlot, Series};
 use super::{BenchError, Csv, format_number};
 use crate::camera::Camera;
 use crate::film::{Frame, ToneMap};
+use crate::metrics::{ErrorMetrics, error_metrics};
 use crate::output::save_frame;
 use crate::render::{ProgressiveRender, render_to_completion};
 use crate::sampler::SamplerKind;
@@ -22,9 +21,6 @@ use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::time::Duration;
-
-/// The ε of relMSE.
-pub const RELATIVE_MSE_EPSILON: f64 = 0.01;
 
 /// One way of rendering that the curves compare.
 #[derive(Clone, Debug, PartialEq)]
@@ -79,44 +75,6 @@ impl Configuration {
             ..settings.clone()
         }
     }
-}
-
-/// Error of an estimate against a reference.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ErrorMetrics {
-    pub rmse: f64,
-    pub relative_mse: f64,
-    /// Mean signed error per channel (R, G, B).
-    pub bias: [f64; 3],
-}
-
-/// Compares two frames of the same size.
-pub fn error_metrics(estimate: &Frame, reference: &Frame) -> Result<ErrorMetrics, BenchError> {
-    if (estimate.width, estimate.height) != (reference.width, reference.height) || estimate.pixels.len() != reference.pixels.len()
-    {
-        return Err(BenchError::Reference(format!(
-            "size {}x{} differs from the estimate's {}x{}",
-            reference.width, reference.height, estimate.width, estimate.height
-        )));
-    }
-    let mut squared = 0.0;
-    let mut relative = 0.0;
-    let mut bias = [0.0; 3];
-    for (x, r) in estimate.pixels.iter().zip(&reference.pixels) {
-        for c in 0..3 {
-            let (x, r) = (x[c] as f64, r[c] as f64);
-            let difference = x - r;
-            squared += difference * difference;
-            relative += difference * difference / (r * r + RELATIVE_MSE_EPSILON);
-            bias[c] += difference;
-        }
-    }
-    let pixels = estimate.pixels.len().max(1) as f64;
-    Ok(ErrorMetrics {
-        rmse: (squared / (3.0 * pixels)).sqrt(),
-        relative_mse: relative / (3.0 * pixels),
-        bias: bias.map(|b| b / pixels),
-    })
 }
 
 /// Wall times `first, 2·first, 4·first …` up to and including `last`.
@@ -197,8 +155,8 @@ pub fn measure_curve(
             ControlFlow::Break(())
         }
     });
-    if let Some(error) = failure {
-        return Err(error);
+    if let Some(mismatch) = failure {
+        return Err(mismatch.into());
     }
     Ok(points)
 }
@@ -378,27 +336,11 @@ impl SceneCurves {
 mod tests {
     use super::*;
 
-    fn frame(pixels: Vec<[f32; 3]>) -> Frame {
-        Frame {
-            width: pixels.len() as u32,
-            height: 1,
-            pixels,
-            noise: Vec::new(),
-        }
-    }
-
-    /// Hand-computed values (exact in f32/f64 up to rounding, tolerance 1e-12).
+    /// A reference of the wrong size names both sizes, reference first.
     #[test]
-    fn metrics_match_their_definitions() {
-        let reference = frame(vec![[1.0, 0.0, 0.5], [0.0, 0.0, 0.0]]);
-        let estimate = frame(vec![[2.0, 0.0, 0.5], [0.0, 0.5, 0.0]]);
-        let m = error_metrics(&estimate, &reference).expect("same size");
-        // Squared errors 1 and 0.25 over 6 values.
-        assert!((m.rmse - (1.25f64 / 6.0).sqrt()).abs() < 1e-12);
-        // relMSE: 1 / (1 + 0.01) and 0.25 / (0 + 0.01), over 6 values.
-        assert!((m.relative_mse - (1.0 / 1.01 + 25.0) / 6.0).abs() < 1e-12);
-        assert_eq!(m.bias, [0.5, 0.25, 0.0]);
-        assert!(error_metrics(&frame(vec![[0.0; 3]]), &reference).is_err());
+    fn a_mismatched_reference_is_reported_with_both_sizes() {
+        let error = BenchError::from(crate::metrics::SizeMismatch(1, 1, 4, 1));
+        assert_eq!(error.to_string(), "reference image: size 4x1 differs from the estimate's 1x1");
     }
 
     #[test]

@@ -39,6 +39,16 @@ pub enum BenchError {
     Threads(#[from] rayon::ThreadPoolBuildError),
 }
 
+impl From<crate::metrics::SizeMismatch> for BenchError {
+    /// An estimate and its reference image of different sizes.
+    fn from(mismatch: crate::metrics::SizeMismatch) -> Self {
+        let crate::metrics::SizeMismatch(estimate_width, estimate_height, width, height) = mismatch;
+        BenchError::Reference(format!(
+            "size {width}x{height} differs from the estimate's {estimate_width}x{estimate_height}"
+        ))
+    }
+}
+
 /// One line describing the machine and its load, for CSV headers: the
 /// benchmarks share a machine, and a time means little without its load.
 pub fn machine_note() -> String {

@@ -170,7 +170,7 @@ pub fn measure(
     let mut builds = Vec::new();
     let mut rows = Vec::new();
     for (name, mesh) in meshes {
-        let scene = super::scaling::mesh_scene(mesh.clone());
+        let scene = Scene::from_mesh(mesh.clone());
         let triangles = scene.primitive_count();
         let build_primitives: Vec<BuildPrimitive> = (0..triangles as u32)
             .map(|primitive| BuildPrimitive {
@@ -330,7 +330,7 @@ pub fn export(meshes: &[(String, Mesh)], directory: &Path) -> Result<(), BenchEr
         file.write_all(&bytes).map_err(io(path))
     };
     for (name, mesh) in meshes {
-        let scene = super::scaling::mesh_scene(mesh.clone());
+        let scene = Scene::from_mesh(mesh.clone());
         let stored = &scene.meshes[0];
         let vertices: Vec<u8> = stored
             .positions

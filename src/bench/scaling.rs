@@ -11,13 +11,11 @@ use super::plot::{LinePlot, Series};
 use super::{BenchError, Csv, format_number};
 use crate::accel::{BuildPrimitive, Bvh};
 use crate::camera::Camera;
-use crate::color::Color;
-use crate::geometry::{Mesh, Shape};
-use crate::material::{Material, Texture};
+use crate::geometry::Mesh;
 use crate::math::Ray;
 use crate::render::render_to_completion;
 use crate::sampler::{Sampler, SamplerKind};
-use crate::scene::{Primitive, Scene};
+use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -73,21 +71,6 @@ pub fn orient_outward(mesh: &mut Mesh, inside: DVec3) {
     }
 }
 
-/// A scene of one mesh with a grey diffuse material and no lights.
-pub fn mesh_scene(mesh: Mesh) -> Scene {
-    let primitives: Vec<Primitive> = mesh
-        .triangles(0)
-        .map(|t| Primitive {
-            shape: Shape::Triangle(t),
-            material: 0,
-        })
-        .collect();
-    let materials = vec![Material::Diffuse {
-        albedo: Texture::Constant(Color::splat(0.5)),
-    }];
-    Scene::new(primitives, vec![mesh], materials, Color::ZERO)
-}
-
 /// One row of the BVH measurement.
 #[derive(Clone, Debug)]
 pub struct BvhRow {
@@ -111,7 +94,7 @@ pub fn measure_bvh(triangle_counts: &[u32], rays: u64, mut progress: impl FnMut(
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
     let mut rows = Vec::new();
     for &target in triangle_counts {
-        let scene = mesh_scene(sphere_mesh(target, DVec3::ZERO, 1.0));
+        let scene = Scene::from_mesh(sphere_mesh(target, DVec3::ZERO, 1.0));
         let bounds: Vec<BuildPrimitive> = (0..scene.primitive_count() as u32)
             .map(|primitive| BuildPrimitive {
                 bounds: scene.primitive_bounds(primitive),

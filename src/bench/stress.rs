@@ -13,21 +13,23 @@
 //!   mesh (where a non-watertight triangle test misses both neighbours), from
 //!   inside and from outside, that hit nothing.
 //!
-//! The scenes: the Cornell box scaled to 10⁻⁴ and to 10⁵ units and moved 10⁵
-//! from the origin; smallpt's room of radius-10⁵ spheres; light grazing a
-//! floor; glass nested in glass with nearly coincident surfaces; Bezier
-//! surfaces of revolution (glass and diffuse vases) at unit scale, 10⁻⁴ and
-//! 10⁵ from the origin. Disagreements of the revolution intersector with an
-//! independent reference are counted by `tests/revolution_stress.rs`.
+//! The scenes (`stress_scenes`) are files in `scenes/stress/`, each placed by
+//! one or more similarities (`scene::Similarity`): the Cornell box scaled to
+//! 10⁻⁴ and to 10⁵ units and moved 10⁵ from the origin; smallpt's room of
+//! radius-10⁵ spheres; light grazing a floor; glass nested in glass with
+//! nearly coincident surfaces; Bezier surfaces of revolution (glass and
+//! diffuse vases) at unit scale, 10⁻⁴ and 10⁵ from the origin. Disagreements
+//! of the revolution intersector with an independent reference are counted
+//! by `tests/revolution_stress.rs`.
 
-use super::scaling::{mesh_scene, sphere_mesh};
+use super::scaling::sphere_mesh;
 use super::{BenchError, Csv};
 use crate::camera::Camera;
 use crate::geometry::{Mesh, SurfaceHit, Transform};
 use crate::math::{Frame as LocalFrame, Ray, warp};
 use crate::render::render_to_completion;
 use crate::sampler::{Sampler, SamplerKind};
-use crate::scene::{LoadedScene, Scene, load_scene_str};
+use crate::scene::{LoadedScene, Scene, SceneError, Similarity, load_scene_str_placed};
 use crate::settings::{IntegratorKind, RenderSettings, SppmSettings};
 use glam::DVec3;
 use std::path::{Path, PathBuf};
@@ -58,320 +60,77 @@ pub struct StressRow {
     pub failures: u64,
 }
 
-/// The Cornell box (the shipped scene's walls, light, mirror and glass balls)
-/// with every coordinate mapped to `offset + scale · x / 555`.
-pub fn cornell_toml(scale: f64, offset: f64) -> String {
-    let p = |v: [f64; 3]| {
-        format!(
-            "[{:e}, {:e}, {:e}]",
-            offset + scale * v[0] / 555.0,
-            offset + scale * v[1] / 555.0,
-            offset + scale * v[2] / 555.0
+/// The text of a scene file under `scenes/stress/`, with its path from the
+/// crate root; compiled in, so `prism bench --stress` runs from anywhere.
+macro_rules! stress_scene_file {
+    ($name:literal) => {
+        (
+            concat!("scenes/stress/", $name),
+            include_str!(concat!("../../scenes/stress/", $name)),
         )
     };
-    let e = |v: [f64; 3]| {
-        format!(
-            "[{:e}, {:e}, {:e}]",
-            scale * v[0] / 555.0,
-            scale * v[1] / 555.0,
-            scale * v[2] / 555.0
-        )
-    };
-    let quad = |corner, u, v, material: &str| {
-        format!(
-            "[[objects]]\ntype = \"quad\"\ncorner = {}\nedge_u = {}\nedge_v = {}\nmaterial = \"{material}\"\n",
-            p(corner),
-            e(u),
-            e(v)
-        )
-    };
-    let sphere = |center, radius: f64, material: &str| {
-        format!(
-            "[[objects]]\ntype = \"sphere\"\ncenter = {}\nradius = {:e}\nmaterial = \"{material}\"\n",
-            p(center),
-            scale * radius / 555.0
-        )
-    };
-    let mut text = format!(
-        "[camera]\nposition = {}\nlook_at = {}\nfov_y_degrees = 39.3\n\n{MATERIALS}",
-        p([278.0, 273.0, -800.0]),
-        p([278.0, 273.0, 0.0])
-    );
-    for object in [
-        quad([0.0, 0.0, 0.0], [555.0, 0.0, 0.0], [0.0, 0.0, 555.0], "white"),
-        quad([0.0, 555.0, 0.0], [555.0, 0.0, 0.0], [0.0, 0.0, 555.0], "white"),
-        quad([0.0, 0.0, 555.0], [555.0, 0.0, 0.0], [0.0, 555.0, 0.0], "white"),
-        quad([555.0, 0.0, 0.0], [0.0, 555.0, 0.0], [0.0, 0.0, 555.0], "red"),
-        quad([0.0, 0.0, 0.0], [0.0, 555.0, 0.0], [0.0, 0.0, 555.0], "green"),
-        quad([213.0, 548.7, 227.0], [130.0, 0.0, 0.0], [0.0, 0.0, 105.0], "light"),
-        sphere([380.0, 100.0, 380.0], 100.0, "mirror"),
-        sphere([180.0, 100.0, 200.0], 100.0, "glass"),
-    ] {
-        text.push('\n');
-        text.push_str(&object);
-    }
-    text
 }
 
-const MATERIALS: &str = r#"[materials.white]
-type = "diffuse"
-albedo = [0.73, 0.73, 0.73]
-[materials.red]
-type = "diffuse"
-albedo = [0.65, 0.05, 0.05]
-[materials.green]
-type = "diffuse"
-albedo = [0.12, 0.45, 0.15]
-[materials.light]
-type = "emissive"
-radiance = [17, 12, 4]
-[materials.mirror]
-type = "mirror"
-[materials.glass]
-type = "glass"
-ior = 1.5
-"#;
-
-/// smallpt's room (Beason 2008): walls are spheres of radius 10⁵ whose
-/// surfaces pass within 100 units of the camera; the light a sphere of
-/// radius 600 poking through the ceiling.
-const SMALLPT: &str = r#"
-[camera]
-position = [50, 52, 295.6]
-look_at = [50, 51.957388, 294.6]
-fov_y_degrees = 54.35
-[materials.red]
-type = "diffuse"
-albedo = [0.75, 0.25, 0.25]
-[materials.blue]
-type = "diffuse"
-albedo = [0.25, 0.25, 0.75]
-[materials.white]
-type = "diffuse"
-albedo = [0.75, 0.75, 0.75]
-[materials.black]
-type = "diffuse"
-albedo = [0, 0, 0]
-[materials.mirror]
-type = "mirror"
-tint = [0.999, 0.999, 0.999]
-[materials.glass]
-type = "glass"
-ior = 1.5
-[materials.light]
-type = "emissive"
-radiance = [12, 12, 12]
-[[objects]]
-type = "sphere"
-center = [100001, 40.8, 81.6]
-radius = 1e5
-material = "red"
-[[objects]]
-type = "sphere"
-center = [-99901, 40.8, 81.6]
-radius = 1e5
-material = "blue"
-[[objects]]
-type = "sphere"
-center = [50, 40.8, 1e5]
-radius = 1e5
-material = "white"
-[[objects]]
-type = "sphere"
-center = [50, 40.8, -99830]
-radius = 1e5
-material = "black"
-[[objects]]
-type = "sphere"
-center = [50, 1e5, 81.6]
-radius = 1e5
-material = "white"
-[[objects]]
-type = "sphere"
-center = [50, -99918.4, 81.6]
-radius = 1e5
-material = "white"
-[[objects]]
-type = "sphere"
-center = [27, 16.5, 47]
-radius = 16.5
-material = "mirror"
-[[objects]]
-type = "sphere"
-center = [73, 16.5, 78]
-radius = 16.5
-material = "glass"
-[[objects]]
-type = "sphere"
-center = [50, 681.33, 81.6]
-radius = 600
-material = "light"
-"#;
-
-/// A floor lit only by a light standing on its far edge, 1 mm above it,
-/// seen from just above the floor: every light path grazes.
-const GRAZING: &str = r#"
-[camera]
-position = [0, 0.02, -4]
-look_at = [0, 0, 0]
-fov_y_degrees = 30
-[materials.floor]
-type = "diffuse"
-albedo = [0.8, 0.8, 0.8]
-[materials.shiny]
-type = "glossy"
-tint = [0.9, 0.9, 0.9]
-roughness = 0.05
-[materials.light]
-type = "emissive"
-radiance = [50, 50, 50]
-[[objects]]
-type = "quad"
-corner = [-5, 0, -5]
-edge_u = [0, 0, 10]
-edge_v = [10, 0, 0]
-material = "floor"
-[[objects]]
-type = "quad"
-corner = [-3, 0.001, 5]
-edge_u = [0, 0.05, 0]
-edge_v = [6, 0, 0]
-material = "light"
-[[objects]]
-type = "sphere"
-center = [0.5, 0.3, 0]
-radius = 0.3
-material = "shiny"
-"#;
-
-/// Glass in glass in glass: a glass box holding a water sphere holding a
-/// diamond sphere whose surface lies 10⁻⁹ inside the water's, and a small
-/// glass ball inside that.
-const NESTED_GLASS: &str = r#"
-[camera]
-position = [0, 1.5, -5]
-look_at = [0, 1, 0]
-fov_y_degrees = 40
-[materials.floor]
-type = "diffuse"
-albedo = [0.7, 0.7, 0.7]
-[materials.glass]
-type = "glass"
-ior = 1.5
-[materials.water]
-type = "glass"
-ior = 1.33
-[materials.diamond]
-type = "glass"
-ior = 2.4
-[materials.light]
-type = "emissive"
-radiance = [10, 10, 10]
-[[objects]]
-type = "quad"
-corner = [-10, 0, -10]
-edge_u = [0, 0, 20]
-edge_v = [20, 0, 0]
-material = "floor"
-[[objects]]
-type = "quad"
-corner = [-1, 4, -1]
-edge_u = [2, 0, 0]
-edge_v = [0, 0, 2]
-material = "light"
-[[objects]]
-type = "box"
-min = [-1, 0, -1]
-max = [1, 2, 1]
-material = "glass"
-[[objects]]
-type = "sphere"
-center = [0, 1, 0]
-radius = 0.8
-material = "water"
-[[objects]]
-type = "sphere"
-center = [0, 1, 0]
-radius = 0.799999999
-material = "diamond"
-[[objects]]
-type = "sphere"
-center = [0, 1, 0]
-radius = 0.3
-material = "glass"
-"#;
-
-/// Two vases turned from one 5-point Bezier profile (surfaces of revolution,
-/// glass and diffuse) on a floor under a ceiling light, like
-/// `scenes/vase.toml`, with every length scaled by `scale` and the whole
-/// moved by `offset` along each axis.
-pub fn vase_toml(scale: f64, offset: f64) -> String {
-    let p = |v: [f64; 3]| {
-        format!(
-            "[{:e}, {:e}, {:e}]",
-            offset + scale * v[0],
-            offset + scale * v[1],
-            offset + scale * v[2]
-        )
-    };
-    let e = |v: [f64; 3]| format!("[{:e}, {:e}, {:e}]", scale * v[0], scale * v[1], scale * v[2]);
-    let quad = |corner, u, v, material: &str| {
-        format!(
-            "[[objects]]\ntype = \"quad\"\ncorner = {}\nedge_u = {}\nedge_v = {}\nmaterial = \"{material}\"\n",
-            p(corner),
-            e(u),
-            e(v)
-        )
-    };
-    let vase = |x: f64, material: &str| {
-        format!(
-            "[[objects]]\ntype = \"revolution\"\nprofile = [[0.0, 0.0], [7.0, 0.4], [0.0, 5.0], [0.2, 5.5], [2.6, 7.5]]\nmaterial = \"{material}\"\ntransform = {{ translate = {}, scale = {scale:e} }}\n",
-            p([x, 0.0, 0.0])
-        )
-    };
-    let mut text = format!(
-        "[camera]\nposition = {}\nlook_at = {}\nfov_y_degrees = 38\n\n{VASE_MATERIALS}",
-        p([0.0, 6.0, 24.0]),
-        p([0.0, 3.5, 0.0])
-    );
-    for object in [
-        quad([-20.0, 0.0, -20.0], [0.0, 0.0, 45.0], [40.0, 0.0, 0.0], "white"),
-        quad([-4.0, 16.0, -4.0], [8.0, 0.0, 0.0], [0.0, 0.0, 8.0], "light"),
-        vase(-3.8, "glass"),
-        vase(3.8, "terracotta"),
-    ] {
-        text.push('\n');
-        text.push_str(&object);
-    }
-    text
+/// One extreme scene: a file under `scenes/stress/`, placed by a similarity
+/// (every length scaled by `scale`, then everything moved by `offset` along
+/// each axis).
+#[derive(Clone, Copy, Debug)]
+pub struct StressScene {
+    pub name: &'static str,
+    /// Path from the crate root; names the scene in errors.
+    pub file: &'static str,
+    text: &'static str,
+    pub scale: f64,
+    pub offset: f64,
 }
 
-const VASE_MATERIALS: &str = r#"[materials.white]
-type = "diffuse"
-albedo = [0.75, 0.75, 0.75]
-[materials.glass]
-type = "glass"
-ior = 1.5
-[materials.terracotta]
-type = "diffuse"
-albedo = [0.7, 0.33, 0.18]
-[materials.light]
-type = "emissive"
-radiance = [12, 12, 12]
-"#;
+impl StressScene {
+    fn new(name: &'static str, (file, text): (&'static str, &'static str), scale: f64, offset: f64) -> Self {
+        Self {
+            name,
+            file,
+            text,
+            scale,
+            offset,
+        }
+    }
 
-/// The extreme scenes, by name, as scene-file text.
-pub fn stress_scenes() -> Vec<(&'static str, String)> {
+    /// The scene file, placed.
+    pub fn load(&self) -> Result<LoadedScene, SceneError> {
+        let placement = Similarity::new(self.scale, DVec3::splat(self.offset)).ok_or_else(|| {
+            SceneError::new(
+                self.file,
+                None,
+                None,
+                format!(
+                    "{}: scale {} and offset {} do not make a placement",
+                    self.name, self.scale, self.offset
+                ),
+            )
+        })?;
+        load_scene_str_placed(self.text, Path::new(self.file), Path::new("."), &placement)
+    }
+}
+
+/// The extreme scenes: the Cornell box (555 units across in its file) shrunk
+/// to 10⁻⁴, grown to 10⁵ and, at unit size, moved 10⁵ from the origin;
+/// smallpt's room of radius-10⁵ spheres; light grazing a floor; glass nested
+/// in glass with nearly coincident surfaces; two Bezier vases (surfaces of
+/// revolution, 7.5 units tall) at unit scale, shrunk 16·10⁴ times, and moved
+/// 10⁵ from the origin.
+pub fn stress_scenes() -> Vec<StressScene> {
+    let cornell = stress_scene_file!("cornell.toml");
+    let vase = stress_scene_file!("vase.toml");
     vec![
-        ("cornell-tiny-1e-4", cornell_toml(1e-4, 0.0)),
-        ("cornell-huge-1e5", cornell_toml(1e5, 0.0)),
-        ("cornell-far-1e5-from-origin", cornell_toml(1.0, 1e5)),
-        ("smallpt-1e5-radius-walls", SMALLPT.to_string()),
-        ("grazing-light", GRAZING.to_string()),
-        ("nested-glass", NESTED_GLASS.to_string()),
-        ("vase-revolution", vase_toml(1.0, 0.0)),
-        ("vase-revolution-tiny-1e-4", vase_toml(1e-4 / 16.0, 0.0)),
-        ("vase-revolution-far-1e5-from-origin", vase_toml(1.0, 1e5)),
+        StressScene::new("cornell-tiny-1e-4", cornell, 1e-4 / 555.0, 0.0),
+        StressScene::new("cornell-huge-1e5", cornell, 1e5 / 555.0, 0.0),
+        StressScene::new("cornell-far-1e5-from-origin", cornell, 1.0 / 555.0, 1e5),
+        StressScene::new("smallpt-1e5-radius-walls", stress_scene_file!("smallpt.toml"), 1.0, 0.0),
+        StressScene::new("grazing-light", stress_scene_file!("grazing.toml"), 1.0, 0.0),
+        StressScene::new("nested-glass", stress_scene_file!("nested-glass.toml"), 1.0, 0.0),
+        StressScene::new("vase-revolution", vase, 1.0, 0.0),
+        StressScene::new("vase-revolution-tiny-1e-4", vase, 1e-4 / 16.0, 0.0),
+        StressScene::new("vase-revolution-far-1e5-from-origin", vase, 1.0, 1e5),
     ]
 }
 
@@ -454,7 +213,7 @@ pub fn leaks(mesh: &Mesh, inside: Option<DVec3>, rays: u64) -> (u64, u64) {
         return (0, 0);
     }
     let extent = crate::math::Aabb::from_points(&mesh.positions).extent().length();
-    let scene = mesh_scene(mesh.clone());
+    let scene = Scene::from_mesh(mesh.clone());
     let (mut tested, mut leaked) = (0, 0);
     for i in 0..rays {
         let mut sampler = Sampler::new(SamplerKind::Random, i, 0, 13);
@@ -546,8 +305,9 @@ pub fn run(options: &StressOptions, mut progress: impl FnMut(&StressRow)) -> Res
         progress(&row);
         rows.push(row);
     };
-    for (name, text) in stress_scenes() {
-        let loaded = load_scene_str(&text, Path::new(name), Path::new("."))?;
+    for stress_scene in stress_scenes() {
+        let name = stress_scene.name;
+        let loaded = stress_scene.load()?;
         for kind in IntegratorKind::ALL {
             let (samples, rejected) = rejected_samples(&loaded, kind, options);
             let row = StressRow {
@@ -592,7 +352,7 @@ pub fn write_results(rows: &[StressRow], options: &StressOptions, machine: &str,
         options.width, options.height, options.passes, options.rays
     ));
     csv.comments
-        .push("Bezier intersection disagreements: not measured (no Bezier revolution shape in this build)".into());
+        .push("Bezier intersection disagreements: counted by tests/revolution_stress.rs, not here".into());
     csv.comments.push(machine.to_string());
     for r in rows {
         csv.rows.push(vec![

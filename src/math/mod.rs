@@ -1,20 +1,23 @@
 //! Small numeric building blocks shared by every module: rays with robust
-//! origins, bounding boxes, orthonormal shading frames and sampling warps;
-//! and the statistics that check sampling code against its densities
-//! (incomplete gamma, adaptive quadrature, χ² goodness-of-fit tests). Those
-//! live in the library, not only in tests/, because the checks sit beside the
-//! code they test (warps here, BSDFs in `material`, shapes in `geometry`).
+//! origins, bounding boxes, orthonormal shading frames, sampling warps,
+//! polynomials in Bernstein form with their real-root isolation; and the
+//! statistics that check sampling code against its densities (incomplete
+//! gamma, adaptive quadrature, χ² goodness-of-fit tests). Those live in the
+//! library, not only in tests/, because the checks sit beside the code they
+//! test (warps here, BSDFs in `material`, shapes in `geometry`).
 //!
 //! Prism works in `f64` throughout. The classic smallpt room is built from
 //! spheres of radius 1e5 whose surfaces sit a few units from the camera; in
 //! `f32` their hit points carry errors larger than the room's details.
 
 pub mod aabb;
+pub mod bernstein;
 pub mod chi_square;
 pub mod frame;
 pub mod gamma;
 pub mod quadrature;
 pub mod ray;
+pub mod roots;
 pub mod warp;
 
 pub use aabb::Aabb;

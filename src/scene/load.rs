@@ -40,7 +40,13 @@ pub fn load_scene_file(path: &Path) -> Result<LoadedScene, SceneError> {
 
 /// Builds a scene from TOML text; `file` names it in errors, `base` resolves paths.
 pub fn load_scene_str(text: &str, file: &Path, base: &Path) -> Result<LoadedScene, SceneError> {
-    let description: SceneDescription = toml::from_str(text).map_err(|e| {
+    build_scene(parse_scene_str(text, file)?, text, file, base)
+}
+
+/// Parses TOML text into a description without building anything, so it can
+/// be edited first (as `scene::Similarity` does); `file` names it in errors.
+pub fn parse_scene_str(text: &str, file: &Path) -> Result<SceneDescription, SceneError> {
+    toml::from_str(text).map_err(|e| {
         let message = e.message().to_string();
         // Tagged tables report errors at their start; point at the offending
         // key itself when the message names it.
@@ -49,7 +55,12 @@ pub fn load_scene_str(text: &str, file: &Path, base: &Path) -> Result<LoadedScen
             .and_then(|rest| rest.split('`').next());
         let line = e.span().map(|span| key_line(text, span, key));
         SceneError::new(file, line, None, message)
-    })?;
+    })
+}
+
+/// Builds a description parsed from `text` by [`parse_scene_str`] (values may
+/// have been edited since; `text` still locates errors by line).
+pub fn build_scene(description: SceneDescription, text: &str, file: &Path, base: &Path) -> Result<LoadedScene, SceneError> {
     Builder { text, file, base }.build(description)
 }
 

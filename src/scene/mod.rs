@@ -1,13 +1,17 @@
 //! Scenes: the plain description parsed from a scene file
 //! (`description`), turned into a frozen, render-ready `Scene` (`load`)
-//! whose acceleration structure is built once and shared read-only.
+//! whose acceleration structure is built once and shared read-only. A
+//! description can be placed by a `similarity` (scaled and moved) before it
+//! is built.
 
 pub mod description;
 pub mod error;
 pub mod load;
+pub mod similarity;
 
 pub use error::SceneError;
 pub use load::{LoadedScene, load_scene_file, load_scene_str};
+pub use similarity::{Similarity, load_scene_str_placed};
 
 use crate::accel::{BuildPrimitive, Bvh, TraversalRay};
 use crate::color::Color;
@@ -15,7 +19,7 @@ use crate::geometry::triangle::TriangleRay;
 use crate::geometry::triangles::{LeafHit, TriangleSource, Triangles, store_mesh_positions, stored_position};
 use crate::geometry::{Mesh, Shape, SurfaceHit, Triangle};
 use crate::light::{Emitter, EmitterSource, Light, Lights};
-use crate::material::Material;
+use crate::material::{Material, Texture};
 use crate::math::{Aabb, Ray};
 
 /// The TOML text of the scene compiled into the binary.
@@ -118,6 +122,23 @@ impl Scene {
             .collect();
         scene.lights = Lights::new(lights, &scene);
         scene
+    }
+
+    /// A scene of one mesh, each triangle a primitive of one grey diffuse
+    /// material, with no lights and a black background: for intersection
+    /// tests and benchmarks.
+    pub fn from_mesh(mesh: Mesh) -> Self {
+        let primitives: Vec<Primitive> = mesh
+            .triangles(0)
+            .map(|t| Primitive {
+                shape: Shape::Triangle(t),
+                material: 0,
+            })
+            .collect();
+        let materials = vec![Material::Diffuse {
+            albedo: Texture::Constant(Color::splat(0.5)),
+        }];
+        Self::new(primitives, vec![mesh], materials, Color::ZERO)
     }
 
     pub fn bounds(&self) -> Aabb {
