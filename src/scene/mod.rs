@@ -1,13 +1,16 @@
-//! Scenes: the plain description parsed from a scene file
-//! (`description`), turned into a frozen, render-ready `Scene` (`load`)
-//! whose acceleration structure is built once and shared read-only.
+//! Scenes: the scene file parsed into a spanned TOML document (`document`),
+//! read as plain data (`description`), then checked and turned into a frozen,
+//! render-ready `Scene` (`load`) whose acceleration structure is built once
+//! and shared read-only. Every error names file, line, column and field
+//! (`error`).
 
 pub mod description;
+pub mod document;
 pub mod error;
 pub mod load;
 
-pub use error::SceneError;
-pub use load::{LoadedScene, load_scene_file, load_scene_str};
+pub use error::{Location, SceneError};
+pub use load::{COORDINATE_LIMIT, LoadedScene, load_scene_file, load_scene_str};
 
 use crate::accel::Bvh;
 use crate::color::Color;
