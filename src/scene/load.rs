@@ -53,20 +53,26 @@ pub fn load_scene_file(path: &Path) -> Result<LoadedScene, SceneError> {
     let cannot_read = |message: String| SceneError::new(path, None, None, message);
     crate::geometry::mesh::regular_file(path).map_err(&cannot_read)?;
     let bytes = std::fs::read(path).map_err(|e| cannot_read(format!("cannot read scene file: {e}")))?;
-    let text = std::str::from_utf8(&bytes).map_err(|e| {
+    let base = path.parent().unwrap_or(Path::new("."));
+    let mut loaded = load_scene_bytes(&bytes, path, base)?;
+    loaded.path = Some(path.to_path_buf());
+    Ok(loaded)
+}
+
+/// Builds a scene from the bytes of a scene file, which must be UTF-8 (an
+/// error names the line and column of the first bad byte).
+pub fn load_scene_bytes(bytes: &[u8], file: &Path, base: &Path) -> Result<LoadedScene, SceneError> {
+    let text = std::str::from_utf8(bytes).map_err(|e| {
         // Everything before the first bad byte is valid text to count in.
         let valid = std::str::from_utf8(&bytes[..e.valid_up_to()]).unwrap_or_default();
         SceneError::new(
-            path,
+            file,
             Some(Location::of_offset(valid, valid.len())),
             None,
             format!("the file is not valid UTF-8 (byte 0x{:02x})", bytes[e.valid_up_to()]),
         )
     })?;
-    let base = path.parent().unwrap_or(Path::new("."));
-    let mut loaded = load_scene_str(text, path, base)?;
-    loaded.path = Some(path.to_path_buf());
-    Ok(loaded)
+    load_scene_str(text, file, base)
 }
 
 /// Builds a scene from TOML text; `file` names it in errors, `base` resolves paths.

@@ -10,7 +10,7 @@ pub mod error;
 pub mod load;
 
 pub use error::{Location, SceneError};
-pub use load::{COORDINATE_LIMIT, LoadedScene, load_scene_file, load_scene_str};
+pub use load::{COORDINATE_LIMIT, LoadedScene, load_scene_bytes, load_scene_file, load_scene_str};
 
 use crate::accel::Bvh;
 use crate::color::Color;
