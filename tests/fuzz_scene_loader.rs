@@ -215,7 +215,7 @@ const BYTES: &[u8] = b"[]{}\"'=,.\n#-+e0123456789 \t\\\0\xff\xc3";
 
 /// One mutated input: 1 to 4 mutations of a seed, or (1 in 16) random bytes
 /// or tokens.
-fn generate(seeds: &[Vec<u8>], rng: &mut Rng) -> Vec<u8> {
+fn generate(seeds: &Seeds, rng: &mut Rng) -> Vec<u8> {
     match rng.below(16) {
         0 => (0..rng.below(512)).map(|_| rng.next() as u8).collect(),
         1 => {
@@ -229,9 +229,16 @@ fn generate(seeds: &[Vec<u8>], rng: &mut Rng) -> Vec<u8> {
             text.into_bytes()
         }
         _ => {
-            let mut input = rng.pick(seeds).clone();
+            // Three inputs in four start from a shipped scene or reproducer,
+            // so mutations reach the builder, not only the parser.
+            let pool = if rng.below(4) > 0 || seeds.corpus.is_empty() {
+                &seeds.scenes
+            } else {
+                &seeds.corpus
+            };
+            let mut input = rng.pick(pool).clone();
             for _ in 0..1 + rng.below(4) {
-                mutate(&mut input, seeds, rng);
+                mutate(&mut input, &seeds.scenes, rng);
             }
             input
         }
@@ -410,10 +417,18 @@ fn corpus_key(signature: &str) -> String {
     words.join(" ")
 }
 
-fn seeds(root: &Path) -> Vec<Vec<u8>> {
+/// What inputs start from: the shipped scenes and the reproducers (valid or
+/// nearly), and the corpus (mostly broken already).
+struct Seeds {
+    scenes: Vec<Vec<u8>>,
+    corpus: Vec<Vec<u8>>,
+}
+
+/// The `.toml` files in `folders` under `root`, in name order.
+fn read_toml_files(root: &Path, folders: &[&str]) -> Vec<Vec<u8>> {
     let mut files = Vec::new();
-    for dir in ["scenes", "tests/fuzz/corpus", "tests/scenes/reproducers"] {
-        if let Ok(entries) = std::fs::read_dir(root.join(dir)) {
+    for folder in folders {
+        if let Ok(entries) = std::fs::read_dir(root.join(folder)) {
             files.extend(entries.filter_map(|e| e.ok()).map(|e| e.path()));
         }
     }
@@ -466,8 +481,11 @@ fn the_corpus_loads_or_fails_cleanly() {
 fn mutated_scenes_never_panic_or_hang() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let base = Arc::new(root.join("tests/fuzz/corpus"));
-    let seeds = Arc::new(seeds(root));
-    assert!(seeds.len() >= 8, "no seed scenes found");
+    let seeds = Arc::new(Seeds {
+        scenes: read_toml_files(root, &["scenes", "tests/scenes/reproducers"]),
+        corpus: read_toml_files(root, &["tests/fuzz/corpus"]),
+    });
+    assert!(seeds.scenes.len() >= 8, "no seed scenes found");
     let inputs = env_number("PRISM_FUZZ_INPUTS", 2_000);
     let seed = env_number("PRISM_FUZZ_SEED", 1);
     let budget = Duration::from_millis(env_number("PRISM_FUZZ_BUDGET_MS", 2_000));
@@ -485,6 +503,7 @@ fn mutated_scenes_never_panic_or_hang() {
     let corpus_keys = Arc::new(Mutex::new(BTreeMap::<String, usize>::new()));
     let loaded = Arc::new(AtomicUsize::new(0));
     let with_field = Arc::new(AtomicUsize::new(0));
+    let without_location = Arc::new(AtomicUsize::new(0));
     let slowest = Arc::new(Mutex::new(Duration::ZERO));
     // A panic is counted and its input kept; the default hook's report of
     // it would only interleave with the summary.
@@ -492,7 +511,20 @@ fn mutated_scenes_never_panic_or_hang() {
     let started = Instant::now();
     let handles: Vec<_> = (0..workers)
         .map(|w| {
-            let (next, current, panics, signatures, corpus_keys, loaded, with_field, slowest, seeds, base, save) = (
+            let (
+                next,
+                current,
+                panics,
+                signatures,
+                corpus_keys,
+                loaded,
+                with_field,
+                without_location,
+                slowest,
+                seeds,
+                base,
+                save,
+            ) = (
                 Arc::clone(&next),
                 Arc::clone(&current),
                 Arc::clone(&panics),
@@ -500,6 +532,7 @@ fn mutated_scenes_never_panic_or_hang() {
                 Arc::clone(&corpus_keys),
                 Arc::clone(&loaded),
                 Arc::clone(&with_field),
+                Arc::clone(&without_location),
                 Arc::clone(&slowest),
                 Arc::clone(&seeds),
                 Arc::clone(&base),
@@ -536,8 +569,12 @@ fn mutated_scenes_never_panic_or_hang() {
                     };
                     match &outcome {
                         Ok(()) => loaded.fetch_add(1, Ordering::Relaxed),
-                        Err(e) if e.field.is_some() => with_field.fetch_add(1, Ordering::Relaxed),
-                        Err(_) => 0,
+                        Err(e) => {
+                            if e.location.is_none() {
+                                without_location.fetch_add(1, Ordering::Relaxed);
+                            }
+                            with_field.fetch_add(usize::from(e.field.is_some()), Ordering::Relaxed)
+                        }
                     };
                     let shape = signature(&outcome);
                     let key = corpus_key(&shape);
@@ -585,11 +622,12 @@ fn mutated_scenes_never_panic_or_hang() {
     let panics = panics.lock().map(|p| p.clone()).unwrap_or_default();
     let signatures = signatures.lock().map(|s| s.len()).unwrap_or_default();
     println!(
-        "fuzz: {inputs} inputs (seed {seed}) in {:.1} s on {workers} threads: {} loaded, {} errors ({} naming a field) of {signatures} kinds, {} panics, 0 hangs; {:.0} µs per input per thread, slowest {:.1} ms (budget {} ms)",
+        "fuzz: {inputs} inputs (seed {seed}) in {:.1} s on {workers} threads: {} loaded, {} errors ({} naming a field, {} without a line) of {signatures} kinds, {} panics, 0 hangs; {:.0} µs per input per thread, slowest {:.1} ms (budget {} ms)",
         elapsed.as_secs_f64(),
         loaded.load(Ordering::Relaxed),
         inputs as usize - loaded.load(Ordering::Relaxed) - panics.len(),
         with_field.load(Ordering::Relaxed),
+        without_location.load(Ordering::Relaxed),
         panics.len(),
         elapsed.as_secs_f64() * 1e6 * workers as f64 / inputs.max(1) as f64,
         slowest.lock().map(|s| s.as_secs_f64() * 1e3).unwrap_or_default(),
