@@ -179,7 +179,11 @@ impl Builder<'_> {
                     (None, _) => [Wrap::Repeat; 2],
                 };
                 let file = self.base.join(t.image.as_deref().unwrap_or_default());
-                regular_file(&file).map_err(|e| self.texture_error(field, Some("image"), format!("image file {e}")))?;
+                // A missing file is reported by the image cache; a folder or a
+                // device (which would be read forever) is refused here.
+                if file.exists() {
+                    regular_file(&file).map_err(|e| self.texture_error(field, Some("image"), format!("image file {e}")))?;
+                }
                 let image = images
                     .load(&file)
                     .map_err(|e| self.texture_error(field, Some("image"), e.to_string()))?;
