@@ -441,6 +441,29 @@ fn env_number(name: &str, default: u64) -> u64 {
     std::env::var(name).ok().and_then(|v| v.parse().ok()).unwrap_or(default)
 }
 
+/// How the inputs fared, for the summary.
+#[derive(Default)]
+struct Counts {
+    loaded: AtomicUsize,
+    with_field: AtomicUsize,
+    without_location: AtomicUsize,
+    not_utf8: AtomicUsize,
+}
+
+impl Counts {
+    fn add(&self, outcome: &Result<(), SceneError>) {
+        let count = |counter: &AtomicUsize, yes: bool| counter.fetch_add(usize::from(yes), Ordering::Relaxed);
+        match outcome {
+            Ok(()) => count(&self.loaded, true),
+            Err(e) => {
+                count(&self.without_location, e.location.is_none());
+                count(&self.not_utf8, e.message.starts_with("the file is not valid UTF-8"));
+                count(&self.with_field, e.field.is_some())
+            }
+        };
+    }
+}
+
 /// Loads one input the way `prism render` would.
 fn load(input: &[u8], base: &Path) -> Result<(), SceneError> {
     load_scene_bytes(input, Path::new("fuzz.toml"), base).map(|_| ())
@@ -501,9 +524,7 @@ fn mutated_scenes_never_panic_or_hang() {
     let panics = Arc::new(Mutex::new(Vec::new()));
     let signatures = Arc::new(Mutex::new(BTreeMap::<String, usize>::new()));
     let corpus_keys = Arc::new(Mutex::new(BTreeMap::<String, usize>::new()));
-    let loaded = Arc::new(AtomicUsize::new(0));
-    let with_field = Arc::new(AtomicUsize::new(0));
-    let without_location = Arc::new(AtomicUsize::new(0));
+    let counts = Arc::new(Counts::default());
     let slowest = Arc::new(Mutex::new(Duration::ZERO));
     // A panic is counted and its input kept; the default hook's report of
     // it would only interleave with the summary.
@@ -511,28 +532,13 @@ fn mutated_scenes_never_panic_or_hang() {
     let started = Instant::now();
     let handles: Vec<_> = (0..workers)
         .map(|w| {
-            let (
-                next,
-                current,
-                panics,
-                signatures,
-                corpus_keys,
-                loaded,
-                with_field,
-                without_location,
-                slowest,
-                seeds,
-                base,
-                save,
-            ) = (
+            let (next, current, panics, signatures, corpus_keys, counts, slowest, seeds, base, save) = (
                 Arc::clone(&next),
                 Arc::clone(&current),
                 Arc::clone(&panics),
                 Arc::clone(&signatures),
                 Arc::clone(&corpus_keys),
-                Arc::clone(&loaded),
-                Arc::clone(&with_field),
-                Arc::clone(&without_location),
+                Arc::clone(&counts),
                 Arc::clone(&slowest),
                 Arc::clone(&seeds),
                 Arc::clone(&base),
@@ -567,15 +573,7 @@ fn mutated_scenes_never_panic_or_hang() {
                             continue;
                         }
                     };
-                    match &outcome {
-                        Ok(()) => loaded.fetch_add(1, Ordering::Relaxed),
-                        Err(e) => {
-                            if e.location.is_none() {
-                                without_location.fetch_add(1, Ordering::Relaxed);
-                            }
-                            with_field.fetch_add(usize::from(e.field.is_some()), Ordering::Relaxed)
-                        }
-                    };
+                    counts.add(&outcome);
                     let shape = signature(&outcome);
                     let key = corpus_key(&shape);
                     if let Ok(mut s) = signatures.lock() {
@@ -622,12 +620,13 @@ fn mutated_scenes_never_panic_or_hang() {
     let panics = panics.lock().map(|p| p.clone()).unwrap_or_default();
     let signatures = signatures.lock().map(|s| s.len()).unwrap_or_default();
     println!(
-        "fuzz: {inputs} inputs (seed {seed}) in {:.1} s on {workers} threads: {} loaded, {} errors ({} naming a field, {} without a line) of {signatures} kinds, {} panics, 0 hangs; {:.0} µs per input per thread, slowest {:.1} ms (budget {} ms)",
+        "fuzz: {inputs} inputs (seed {seed}) in {:.1} s on {workers} threads: {} loaded, {} errors ({} naming a field, {} invalid UTF-8, {} without a line) of {signatures} kinds, {} panics, 0 hangs; {:.0} µs per input per thread, slowest {:.1} ms (budget {} ms)",
         elapsed.as_secs_f64(),
-        loaded.load(Ordering::Relaxed),
-        inputs as usize - loaded.load(Ordering::Relaxed) - panics.len(),
-        with_field.load(Ordering::Relaxed),
-        without_location.load(Ordering::Relaxed),
+        counts.loaded.load(Ordering::Relaxed),
+        inputs as usize - counts.loaded.load(Ordering::Relaxed) - panics.len(),
+        counts.with_field.load(Ordering::Relaxed),
+        counts.not_utf8.load(Ordering::Relaxed),
+        counts.without_location.load(Ordering::Relaxed),
         panics.len(),
         elapsed.as_secs_f64() * 1e6 * workers as f64 / inputs.max(1) as f64,
         slowest.lock().map(|s| s.as_secs_f64() * 1e3).unwrap_or_default(),

@@ -104,7 +104,14 @@ impl<'t> Document<'t> {
         match errors.into_iter().next() {
             None => Ok(document),
             Some(error) => {
+                let offset = error.span().map(|span| span.start);
                 let mut error = document.error_at(error.span(), error.message());
+                // Where the partial document holds nothing at the error (a
+                // broken line is left out of it), name the field from the text.
+                if let (None, Some(offset)) = (&error.field, offset) {
+                    let path = path_from_text(text, offset);
+                    error.field = (!path.is_root()).then(|| path.to_string());
+                }
                 // A parser that stopped inside an array may have recovered
                 // elements that are not there; name the array, not an index.
                 if let Some(field) = &mut error.field {
@@ -255,6 +262,55 @@ fn innermost(value: &Spanned<DeValue<'_>>, span: &Range<usize>, path: FieldPath)
     holds(&value.span(), span).then_some(path)
 }
 
+/// For a syntax error only: the table header in effect at `offset` (with
+/// its index, for an array of tables) and the key its line assigns, read
+/// from the text. A fallback for when the parser's partial document has
+/// nothing at the error, so it need not handle every TOML form.
+fn path_from_text(text: &str, offset: usize) -> FieldPath {
+    let mut offset = offset.min(text.len());
+    while !text.is_char_boundary(offset) {
+        offset -= 1;
+    }
+    let line_start = text[..offset].rfind('\n').map_or(0, |i| i + 1);
+    let line_end = text[offset..].find('\n').map_or(text.len(), |i| offset + i);
+    let mut path = FieldPath::root();
+    let mut arrays: Vec<(String, usize)> = Vec::new();
+    for line in text[..line_start].lines() {
+        let line = line.trim();
+        if let Some(name) = line.strip_prefix("[[").and_then(|rest| rest.split("]]").next()) {
+            let name = name.trim().to_string();
+            let index = match arrays.iter_mut().find(|(n, _)| *n == name) {
+                Some((_, count)) => {
+                    *count += 1;
+                    *count - 1
+                }
+                None => {
+                    arrays.push((name.clone(), 1));
+                    0
+                }
+            };
+            path = dotted(FieldPath::root(), &name).index(index);
+        } else if let Some(name) = line.strip_prefix('[').and_then(|rest| rest.split(']').next()) {
+            path = dotted(FieldPath::root(), name);
+        }
+    }
+    match text[line_start..line_end].split_once('=') {
+        Some((key, _)) if !key.trim().is_empty() && !key.contains(['[', '{', '#']) => dotted(path, key),
+        _ => path,
+    }
+}
+
+/// `path` extended by a dotted key as written (`a.b`, `"quoted key"`).
+fn dotted(mut path: FieldPath, key: &str) -> FieldPath {
+    for part in key.split('.') {
+        let part = part.trim().trim_matches(['"', '\'']);
+        if !part.is_empty() {
+            path = path.key(part);
+        }
+    }
+    path
+}
+
 /// Whether `outer` holds `inner` (an empty `inner` is a position: it may sit
 /// at `outer`'s end, where a parser notices what is missing).
 fn holds(outer: &Range<usize>, inner: &Range<usize>) -> bool {
@@ -293,6 +349,13 @@ mod tests {
         assert_eq!(error.to_string(), "s.toml:2:16: camera.position[1]: invalid type");
         let error = document.error(&FieldPath::root().key("objects").index(0).key("radius"), "too big");
         assert_eq!(error.to_string(), "s.toml:5:10: objects[0].radius: too big");
+        // A syntax error the parser left out of its document is named from the text.
+        let text = "[camera]\nposition = [0, 0, 5]\n[[objects]]\nradius = 1\n[[objects]]\nradius = 1.x\n";
+        let error = Document::parse(text, file).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(
+            error.starts_with("s.toml:6:12: objects[1].radius: invalid fraction"),
+            "{error}"
+        );
         // A missing key is placed at the table that lacks it.
         let error = document.error(&FieldPath::root().key("camera").key("look_at"), "missing");
         assert_eq!(error.to_string(), "s.toml:1:1: camera.look_at: missing");
