@@ -106,7 +106,8 @@ impl Builder<'_> {
             }
             return Ok(vec![material; faces]);
         }
-        let unassigned = obj.face_materials.iter().filter(|m| m.is_none()).count();
+        let known = |m: &Option<usize>| m.is_some_and(|m| m < obj.materials.len());
+        let unassigned = obj.face_materials.iter().filter(|m| !known(m)).count();
         if unassigned > 0 || obj.materials.is_empty() {
             let why = match &obj.material_error {
                 Some(reason) => format!("its material library could not be read ({reason})"),
