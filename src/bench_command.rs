@@ -78,9 +78,7 @@ pub struct BenchArgs {
 }
 
 pub fn bench_command(args: BenchArgs) -> Result<()> {
-    if args.threads == 0 {
-        bail!("--threads must be at least 1");
-    }
+    prism::settings::validate::thread_count(args.threads)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads)
         .build()
@@ -121,8 +119,12 @@ fn stem(path: &Path) -> String {
 }
 
 fn references_command(args: &BenchArgs, seconds: f64) -> Result<()> {
-    if !(seconds.is_finite() && seconds > 0.0) || args.reference_width == 0 {
-        bail!("--make-references needs a positive number of seconds and --reference-width at least 1");
+    prism::settings::validate::time_limit(seconds).context("--make-references")?;
+    if !(1..=prism::settings::validate::MAX_IMAGE_SIDE).contains(&args.reference_width) {
+        bail!(
+            "--reference-width: must be between 1 and {} pixels",
+            prism::settings::validate::MAX_IMAGE_SIDE
+        );
     }
     for file in scene_files(args)? {
         let loaded = scene::load_scene_file(&file)?;
@@ -145,8 +147,9 @@ fn references_command(args: &BenchArgs, seconds: f64) -> Result<()> {
 }
 
 fn curves_command(args: &BenchArgs) -> Result<()> {
-    if !(args.min_seconds > 0.0 && args.max_seconds >= args.min_seconds) {
-        bail!("need 0 < --min-seconds <= --max-seconds");
+    let max = prism::settings::validate::MAX_TIME_SECONDS;
+    if !(args.min_seconds > 0.0 && args.max_seconds >= args.min_seconds && args.max_seconds <= max) {
+        bail!("need 0 < --min-seconds <= --max-seconds <= {max:e}");
     }
     let ladder = error_curves::time_ladder(args.min_seconds, args.max_seconds);
     if args.adaptive_threshold.iter().any(|t| !(t.is_finite() && *t > 0.0)) {
@@ -285,7 +288,10 @@ fn rays_command(args: &BenchArgs) -> Result<()> {
     if plot::ENABLED {
         eprintln!("wrote rays.csv, rays_build.csv and rays.png in {}", args.output_dir.display());
     } else {
-        eprintln!("wrote rays.csv and rays_build.csv in {} ({PLOTS_DISABLED})", args.output_dir.display());
+        eprintln!(
+            "wrote rays.csv and rays_build.csv in {} ({PLOTS_DISABLED})",
+            args.output_dir.display()
+        );
     }
     Ok(())
 }

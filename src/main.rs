@@ -2,18 +2,22 @@
 
 mod bench_command;
 
-use anyhow::{Context, Result, bail};
+mod interrupt;
+
+use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use prism::film::ToneMap;
+use prism::output::PendingImage;
 use prism::render::{IntegratorKind, ProgressiveRender, RenderSettings};
 use prism::sampler::SamplerKind;
 use prism::scene::{self, LoadedScene};
+use prism::settings::validate::{self, available_memory};
+use prism::settings::{Setting, SettingsPatch};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::AtomicBool;
-use std::time::Duration;
 
 #[derive(Parser)]
 #[command(name = "prism", version, about = "A physically based renderer you watch converge")]
@@ -35,7 +39,10 @@ enum Command {
     },
 }
 
+/// Numbers may be negative (`--radius -1`), so a bad value gets Prism's range
+/// message rather than clap's "unexpected argument" tip.
 #[derive(Args, Debug)]
+#[command(allow_negative_numbers = true)]
 struct RenderArgs {
     /// Scene file (TOML); the embedded default scene if omitted.
     scene: Option<PathBuf>,
@@ -54,7 +61,7 @@ struct RenderArgs {
     /// Image height in pixels (default: the scene's).
     #[arg(long)]
     height: Option<u32>,
-    /// Worker threads (default: all cores).
+    /// Worker threads, 1 to 256 (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
     /// The same scene, seed and sample count give the same image on any thread count.
@@ -66,7 +73,7 @@ struct RenderArgs {
     /// pt (NEE + MIS), pt-bsdf (BSDF sampling only) or sppm.
     #[arg(long, value_parser = parse_integrator)]
     integrator: Option<IntegratorKind>,
-    /// Maximum number of bounces.
+    /// Maximum number of bounces, 1 to 1024.
     #[arg(long)]
     max_depth: Option<u32>,
     /// Adaptive sampling: stop sampling a pixel once its standard error /
@@ -82,7 +89,7 @@ struct RenderArgs {
     /// SPPM: fraction of each iteration's photons kept, in (0, 1) (default 2/3).
     #[arg(long)]
     alpha: Option<f64>,
-    /// Exposure in stops (display only; EXR output is scaled too).
+    /// Exposure in stops, -64 to 64 (display only; EXR output is scaled too).
     #[arg(long, default_value_t = 0.0)]
     exposure: f64,
     /// clamp, reinhard or filmic (8-bit outputs only).
@@ -121,17 +128,26 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Render(args)) => render_command(args),
-        Some(Command::Bench(args)) => bench_command::bench_command(args),
-        Some(Command::View { scene }) => view_command(scene),
-        None => view_command(None),
+        Some(Command::Bench(args)) => bench_command::bench_command(args).map(|()| RenderEnd::Completed),
+        Some(Command::View { scene }) => view_command(scene).map(|()| RenderEnd::Completed),
+        None => view_command(None).map(|()| RenderEnd::Completed),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(RenderEnd::Completed) => ExitCode::SUCCESS,
+        // The shell's convention for "ended by signal N", though the image was saved.
+        Ok(RenderEnd::Interrupted(signal)) => ExitCode::from(128 + signal as u8),
         Err(error) => {
             eprintln!("error: {error:#}");
             ExitCode::FAILURE
         }
     }
+}
+
+/// How a command that ran to its end ended.
+enum RenderEnd {
+    Completed,
+    /// Stopped early by this signal, with the image so far saved.
+    Interrupted(i32),
 }
 
 /// Opens the viewer; without a display it says how to render headless instead.
@@ -161,74 +177,53 @@ fn load(scene: Option<&Path>) -> Result<LoadedScene> {
     })
 }
 
+/// The command line's settings, through the same validation as a scene
+/// file's `[render]` table; errors name the flag.
 fn apply_overrides(settings: &mut RenderSettings, args: &RenderArgs) -> Result<()> {
-    if let Some(w) = args.width {
-        settings.width = w;
-    }
-    if let Some(h) = args.height {
-        settings.height = h;
-    }
-    if settings.width == 0 || settings.height == 0 {
-        bail!("--width and --height must be at least 1");
-    }
-    if let Some(time) = args.time {
-        if !(time.is_finite() && time > 0.0) {
-            bail!("--time must be a positive number of seconds");
-        }
-        settings.time_limit = Some(Duration::from_secs_f64(time));
-        settings.samples_per_pixel = None;
-    }
-    if let Some(spp) = args.spp {
-        if spp == 0 {
-            bail!("--spp must be at least 1");
-        }
-        settings.samples_per_pixel = Some(spp);
-    }
-    if let Some(depth) = args.max_depth {
-        settings.max_depth = depth;
-    }
-    settings.seed = args.seed.unwrap_or(settings.seed);
-    settings.sampler = args.sampler.unwrap_or(settings.sampler);
-    settings.integrator = args.integrator.unwrap_or(settings.integrator);
-    if let Some(threshold) = args.adaptive_threshold {
-        if !(threshold.is_finite() && threshold > 0.0) {
-            bail!("--adaptive-threshold must be a positive number");
-        }
-        settings.adaptive_threshold = Some(threshold);
-    }
-    if let Some(photons) = args.photons {
-        if photons == 0 {
-            bail!("--photons must be at least 1");
-        }
-        settings.sppm.photons_per_iteration = photons;
-    }
-    if let Some(radius) = args.radius {
-        if !(radius.is_finite() && radius > 0.0) {
-            bail!("--radius must be a positive number");
-        }
-        settings.sppm.initial_radius = Some(radius);
-    }
-    if let Some(alpha) = args.alpha {
-        if !(alpha > 0.0 && alpha < 1.0) {
-            bail!("--alpha must be strictly between 0 and 1");
-        }
-        settings.sppm.alpha = alpha;
-    }
+    let patch = SettingsPatch {
+        width: args.width,
+        height: args.height,
+        spp: args.spp,
+        max_depth: args.max_depth,
+        integrator: args.integrator,
+        sampler: args.sampler,
+        seed: args.seed,
+        photons_per_iteration: args.photons,
+        initial_radius: args.radius,
+        alpha: args.alpha,
+        adaptive_threshold: args.adaptive_threshold,
+        time_seconds: args.time,
+    };
+    patch.apply_to(settings)?;
+    settings.check_memory(available_memory()).map_err(|mut error| {
+        // Name the flag that made the image too large.
+        error.setting = match (args.width, args.height, args.integrator) {
+            (None, Some(_), _) => Setting::Height,
+            (None, None, Some(_)) => Setting::Integrator,
+            _ => Setting::Width,
+        };
+        error
+    })?;
     Ok(())
 }
 
-fn render_command(args: RenderArgs) -> Result<()> {
-    if prism::output::ImageFormat::from_path(&args.output).is_none() {
-        bail!(
-            "{}: unsupported image format (use .png, .bmp, .ppm or .exr)",
-            args.output.display()
-        );
-    }
+fn render_command(args: RenderArgs) -> Result<RenderEnd> {
+    validate::exposure(args.exposure)?;
+    let threads = match args.threads {
+        Some(threads) => validate::thread_count(threads)?,
+        None => std::thread::available_parallelism().map_or(1, |n| n.get().min(validate::MAX_THREADS)),
+    };
+    // The output is checked, and its temporary file made, before any work.
+    let output = PendingImage::create(&args.output)?;
+    let interrupt = interrupt::Interrupt::install(output.temporary_path())?;
     let loaded = load(args.scene.as_deref())?;
+    for warning in &loaded.warnings {
+        eprintln!("warning: {warning}");
+    }
     let mut settings = loaded.settings.clone();
     apply_overrides(&mut settings, &args)?;
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads.unwrap_or(0))
+        .num_threads(threads)
         .build()
         .context("cannot start worker threads")?;
 
@@ -247,14 +242,19 @@ fn render_command(args: RenderArgs) -> Result<()> {
             }
             let status = render.integrator().status();
             bar.set_message(format!("{} passes, {:.2} Msamples/s {status}", progress.passes, rate / 1e6));
-            ControlFlow::Continue(())
+            // A first SIGINT or SIGTERM ends the render here, between passes.
+            match interrupt.received() {
+                Some(_) => ControlFlow::Break(()),
+                None => ControlFlow::Continue(()),
+            }
         })
     });
+    let interrupted = interrupt.received();
     let integrator = render.integrator();
     bar.finish_and_clear();
 
     let frame = integrator.frame();
-    let metadata = vec![
+    let mut metadata = vec![
         ("Software".to_string(), format!("prism {}", env!("CARGO_PKG_VERSION"))),
         (
             "Scene".to_string(),
@@ -268,12 +268,27 @@ fn render_command(args: RenderArgs) -> Result<()> {
         ("RenderSeconds".to_string(), format!("{:.3}", started.elapsed().as_secs_f64())),
         ("Sampler".to_string(), settings.sampler.to_string()),
     ];
-    prism::output::save_frame(&frame, &args.output, args.exposure, args.tone_map, &metadata)?;
+    if let Some(signal) = interrupted {
+        metadata.push(("Interrupted".to_string(), interrupt::name(signal).to_string()));
+    }
+    output.save(&frame, args.exposure, args.tone_map, &metadata)?;
+    // From here a second signal has nothing left to protect.
+    interrupt.uninstall();
     if integrator.rejected_samples() > 0 {
         eprintln!(
             "warning: {} samples were NaN or infinite and were dropped",
             integrator.rejected_samples()
         );
+    }
+    let target = settings.samples_per_pixel.map_or(String::new(), |spp| format!(" of {spp}"));
+    if let Some(signal) = interrupted {
+        eprintln!(
+            "interrupted by {}: wrote {} with the {}{target} passes completed",
+            interrupt::name(signal),
+            args.output.display(),
+            integrator.passes(),
+        );
+        return Ok(RenderEnd::Interrupted(signal));
     }
     if !args.quiet {
         eprintln!(
@@ -290,7 +305,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
             }
         );
     }
-    Ok(())
+    Ok(RenderEnd::Completed)
 }
 
 fn progress_bar(settings: &RenderSettings, quiet: bool) -> ProgressBar {

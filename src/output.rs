@@ -45,29 +45,80 @@ pub fn save_frame(
     tone_map: ToneMap,
     metadata: &[(String, String)],
 ) -> Result<(), OutputError> {
-    let format = ImageFormat::from_path(path).ok_or_else(|| OutputError::UnsupportedFormat {
-        path: path.to_path_buf(),
-    })?;
-    let failed = |message: String| OutputError::Write {
-        path: path.to_path_buf(),
-        message,
-    };
-    let directory = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    if !directory.is_dir() {
-        return Err(failed(format!("folder {} does not exist", directory.display())));
+    PendingImage::create(path)?.save(frame, exposure_stops, tone_map, metadata)
+}
+
+/// An image file about to be written, checked before any rendering: its
+/// format is known and its temporary file already exists in the destination
+/// folder (so the folder exists and is writable). [`PendingImage::save`]
+/// writes the temporary file and renames it into place; dropping an unsaved
+/// one removes the temporary file.
+#[derive(Debug)]
+pub struct PendingImage {
+    path: PathBuf,
+    temporary: PathBuf,
+    format: ImageFormat,
+}
+
+impl PendingImage {
+    /// Checks the format and creates the (empty) temporary file.
+    pub fn create(path: &Path) -> Result<Self, OutputError> {
+        let format = ImageFormat::from_path(path).ok_or_else(|| OutputError::UnsupportedFormat {
+            path: path.to_path_buf(),
+        })?;
+        let failed = |message: String| OutputError::Write {
+            path: path.to_path_buf(),
+            message,
+        };
+        let directory = match path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        if !directory.is_dir() {
+            return Err(failed(format!("folder {} does not exist", directory.display())));
+        }
+        if path.is_dir() {
+            return Err(failed("is a directory".into()));
+        }
+        let file_name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        let temporary = directory.join(format!(".{file_name}.{}.tmp", std::process::id()));
+        File::create(&temporary).map_err(|e| failed(format!("cannot create a file in {}: {e}", directory.display())))?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            temporary,
+            format,
+        })
     }
-    let file_name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let temporary = directory.join(format!(".{file_name}.{}.tmp", std::process::id()));
-    let result = write_to(frame, &temporary, format, exposure_stops, tone_map, metadata)
-        .and_then(|()| std::fs::rename(&temporary, path).map_err(|e| e.to_string()));
-    if let Err(message) = result {
-        let _ = std::fs::remove_file(&temporary);
-        return Err(failed(message));
+
+    /// The temporary file, for a caller that must remove it on a hard exit.
+    pub fn temporary_path(&self) -> &Path {
+        &self.temporary
     }
-    Ok(())
+
+    /// Writes `frame` to the temporary file and renames it to the final name.
+    pub fn save(
+        self,
+        frame: &Frame,
+        exposure_stops: f64,
+        tone_map: ToneMap,
+        metadata: &[(String, String)],
+    ) -> Result<(), OutputError> {
+        let result = write_to(frame, &self.temporary, self.format, exposure_stops, tone_map, metadata)
+            .and_then(|()| std::fs::rename(&self.temporary, &self.path).map_err(|e| e.to_string()));
+        result.map_err(|message| OutputError::Write {
+            path: self.path.clone(),
+            message,
+        })
+        // Drop removes the temporary file if the rename did not happen.
+    }
+}
+
+impl Drop for PendingImage {
+    fn drop(&mut self) {
+        if self.temporary.exists() {
+            let _ = std::fs::remove_file(&self.temporary);
+        }
+    }
 }
 
 fn write_to(

@@ -3,12 +3,16 @@
 //! viewer alike. Every field is a *sampling* parameter: changing one restarts
 //! accumulation but keeps the scene and its BVH. Settings that only one
 //! integrator reads are defined beside it (as plain data with no imports of
-//! their own) and gathered here.
+//! their own) and gathered here. Their one validation, shared by the scene
+//! file and the command line, is in [`validate`].
+
+pub mod validate;
 
 pub use crate::integrator::sppm::settings::SppmSettings;
 use crate::sampler::SamplerKind;
 use serde::{Deserialize, Serialize};
 use std::time::Duration;
+pub use validate::{Setting, SettingError, SettingsPatch};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Deserialize, Serialize)]
 pub enum IntegratorKind {

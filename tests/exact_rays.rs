@@ -20,10 +20,10 @@ use num_bigint::BigInt;
 use num_traits::{Signed, Zero};
 use prism::accel::TraversalRay;
 use prism::bench::scaling::sphere_mesh;
-use prism::scene::Scene;
 use prism::geometry::triangle::TriangleRay;
 use prism::math::Ray;
 use prism::sampler::{Sampler, SamplerKind};
+use prism::scene::Scene;
 use rayon::prelude::*;
 use std::cmp::Ordering;
 

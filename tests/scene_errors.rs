@@ -1,7 +1,8 @@
-//! Bad scenes give one clear line naming file, line and field, a non-zero
-//! exit code, and no panic.
+//! Bad scenes give one clear line naming file, line, column and the full
+//! field path, a non-zero exit code, no panic and no image. One test per
+//! category of error, each asserting the exact location and path.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 const GOOD: &str = r#"[camera]
@@ -13,20 +14,33 @@ type = "diffuse"
 albedo = [0.5, 0.5, 0.5]
 "#;
 
-fn write_scene(name: &str, text: &str) -> PathBuf {
+/// GOOD plus one sphere whose lines (9 to 13) are `type`, `center`, `radius`
+/// and `material`, with `replace` applied to the sphere's text.
+fn sphere_scene(from: &str, to: &str) -> String {
+    let sphere = "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"white\"\n";
+    assert!(sphere.contains(from), "{from}");
+    format!("{GOOD}\n{}", sphere.replace(from, to))
+}
+
+fn scratch_dir() -> PathBuf {
     let dir = std::env::temp_dir().join(format!("prism-scene-errors-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
-    let path = dir.join(name);
+    dir
+}
+
+fn write_scene(name: &str, text: impl AsRef<[u8]>) -> PathBuf {
+    let path = scratch_dir().join(name);
     std::fs::write(&path, text).expect("write scene");
     path
 }
 
-/// Runs `prism render` on the scene; returns (exit success, stderr).
-fn run(path: &PathBuf) -> (bool, String) {
+/// Runs `prism render` with `args` on the scene; returns (exit success, stderr).
+fn run_with(path: &Path, args: &[&str]) -> (bool, String) {
     let out_image = path.with_extension("png");
     let output = Command::new(env!("CARGO_BIN_EXE_prism"))
         .args(["render", "--quiet", "--spp", "1", "--width", "8", "--height", "8", "-o"])
         .arg(&out_image)
+        .args(args)
         .arg(path)
         .output()
         .expect("run prism");
@@ -34,89 +48,272 @@ fn run(path: &PathBuf) -> (bool, String) {
     (output.status.success(), String::from_utf8_lossy(&output.stderr).into_owned())
 }
 
-fn check(name: &str, text: &str, line: usize, field: &str, words: &str) {
+/// The error for `text` is exactly `file:line:column: field: message...`
+/// (`field` empty when the error has none), on one line, with `words` in
+/// the message.
+fn check(name: &str, text: impl AsRef<[u8]>, line: usize, column: usize, field: &str, words: &str) {
     let path = write_scene(name, text);
-    let (success, stderr) = run(&path);
+    let (success, stderr) = run_with(&path, &[]);
     assert!(!success, "{name}: exit code was 0");
     assert!(!stderr.contains("panicked"), "{name}: panicked: {stderr}");
     let lines: Vec<&str> = stderr.lines().collect();
     assert_eq!(lines.len(), 1, "{name}: expected one line, got {stderr:?}");
-    let expected_location = format!("{}:{line}:", path.display());
+    let field = if field.is_empty() {
+        String::new()
+    } else {
+        format!("{field}: ")
+    };
+    let expected = format!("error: {}:{line}:{column}: {field}", path.display());
     assert!(
-        lines[0].contains(&expected_location),
-        "{name}: no {expected_location} in {stderr:?}"
+        lines[0].starts_with(&expected),
+        "{name}: expected {expected:?}…, got {:?}",
+        lines[0]
     );
-    assert!(lines[0].contains(field), "{name}: no field {field} in {stderr:?}");
     assert!(lines[0].contains(words), "{name}: no '{words}' in {stderr:?}");
 }
 
 #[test]
 fn syntax_error() {
-    let text = format!("{GOOD}\n[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0\nradius = 1\nmaterial = \"white\"\n");
+    let text = sphere_scene("center = [0, 0, 0]", "center = [0, 0, 0");
     // The parser notices the unclosed array where the next line begins.
-    check("syntax.toml", &text, 12, "", "expected");
+    check("syntax.toml", text, 12, 1, "objects[0].center", "expected `,`");
 }
 
 #[test]
-fn unknown_material() {
-    let text = format!("{GOOD}\n[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"chrome\"\n");
+fn type_error_inside_an_object_is_placed_at_the_value() {
+    // Not at the first [[objects]] header: the value itself, with its index.
+    let text = format!(
+        "{}{}",
+        sphere_scene("radius = 1", "radius = 1"),
+        "\n[[objects]]\ntype = \"sphere\"\ncenter = [0, \"up\", 0]\nradius = 1\nmaterial = \"white\"\n"
+    );
+    check(
+        "type.toml",
+        text,
+        17,
+        14,
+        "objects[1].center[1]",
+        "invalid type: string \"up\"",
+    );
+}
+
+#[test]
+fn unknown_key() {
+    let text = sphere_scene("material = \"white\"", "material = \"white\"\ncolour = [1, 0, 0]");
+    check("field.toml", text, 14, 1, "objects[0].colour", "colour");
+}
+
+#[test]
+fn unknown_key_in_a_texture_table() {
+    let text = GOOD.replace(
+        "albedo = [0.5, 0.5, 0.5]",
+        "albedo = { checker = [[0, 0, 0], [1, 1, 1]], scael = 2 }",
+    );
+    check(
+        "texture.toml",
+        text,
+        7,
+        46,
+        "materials.white.albedo.scael",
+        "unknown field `scael`",
+    );
+}
+
+#[test]
+fn missing_key_names_the_table_it_is_missing_from() {
+    let text = GOOD.replace("position = [0, 0, 5]\n", "");
+    check("missing.toml", text, 1, 1, "camera.position", "missing field `position`");
+    let text = sphere_scene("radius = 1\n", "");
+    check(
+        "missing-radius.toml",
+        text,
+        9,
+        1,
+        "objects[0].radius",
+        "missing field `radius`",
+    );
+}
+
+#[test]
+fn unknown_kind_names_the_type_key() {
+    let text = sphere_scene("type = \"sphere\"", "type = \"spehre\"");
+    check("kind.toml", text, 10, 8, "objects[0].type", "unknown variant `spehre`");
+}
+
+#[test]
+fn range_error() {
+    let text = sphere_scene("radius = 1", "radius = -2");
+    check(
+        "radius.toml",
+        text,
+        12,
+        10,
+        "objects[0].radius",
+        "must be positive (found -2)",
+    );
+    let text = GOOD.replace("type = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]", "type = \"glass\"\nior = -1.5");
+    check("ior.toml", text, 7, 7, "materials.white.ior", "must be positive");
+}
+
+#[test]
+fn reference_error() {
+    let text = sphere_scene("material = \"white\"", "material = \"chrome\"");
     check(
         "material.toml",
-        &text,
+        text,
         13,
+        12,
         "objects[0].material",
         "unknown material \"chrome\"",
     );
 }
 
 #[test]
-fn negative_radius() {
-    let text = format!("{GOOD}\n[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = -2\nmaterial = \"white\"\n");
-    check("radius.toml", &text, 12, "objects[0].radius", "must be positive");
-}
-
-#[test]
-fn missing_mesh_file() {
-    let text = format!("{GOOD}\n[[objects]]\ntype = \"mesh\"\nfile = \"no-such-bunny.obj\"\nmaterial = \"white\"\n");
-    check("mesh.toml", &text, 11, "objects[0].file", "no-such-bunny.obj");
+fn invalid_utf8_is_placed_at_the_first_bad_byte() {
+    let mut text = GOOD.as_bytes().to_vec();
+    // Line 5 is `[materials.white]`: a Latin-1 é after "[materials.wh".
+    let at = GOOD.find("ite]").expect("marker");
+    text[at] = 0xE9;
+    check("latin1.toml", text, 5, 14, "", "not valid UTF-8 (byte 0xe9)");
 }
 
 #[test]
 fn nan_value() {
-    let text = format!("{GOOD}\n[[objects]]\ntype = \"sphere\"\ncenter = [0, nan, 0]\nradius = 1\nmaterial = \"white\"\n");
-    check("nan.toml", &text, 11, "objects[0].center", "finite");
+    let text = sphere_scene("center = [0, 0, 0]", "center = [0, nan, 0]");
+    check("nan.toml", text, 11, 14, "objects[0].center[1]", "finite");
 }
 
 #[test]
-fn unknown_field() {
-    let text = format!(
-        "{GOOD}\n[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"white\"\ncolour = [1, 0, 0]\n"
-    );
-    check("field.toml", &text, 14, "", "colour");
+fn coordinates_beyond_the_documented_range() {
+    let text = sphere_scene("center = [0, 0, 0]", "center = [0, 0, 2e12]");
+    check("far.toml", text, 11, 17, "objects[0].center[2]", "within ±1e12");
+    let text = GOOD.replace("position = [0, 0, 5]", "position = [0, 0, 1e308]");
+    check("camera-far.toml", text, 2, 19, "camera.position[2]", "within ±1e12");
 }
 
 #[test]
-fn unwritable_output_is_a_clear_error() {
-    let path = write_scene("fine.toml", GOOD);
-    let output = Command::new(env!("CARGO_BIN_EXE_prism"))
-        .args([
-            "render",
-            "--quiet",
-            "--spp",
-            "1",
-            "--width",
-            "8",
-            "--height",
-            "8",
-            "-o",
-            "/nonexistent-folder/x.png",
-        ])
-        .arg(&path)
-        .output()
-        .expect("run prism");
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(
-        !output.status.success() && stderr.contains("/nonexistent-folder/x.png") && !stderr.contains("panicked"),
-        "{stderr}"
+fn missing_mesh_file() {
+    let text = sphere_scene(
+        "type = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1",
+        "type = \"mesh\"\nfile = \"no-such-bunny.obj\"",
     );
+    check("mesh.toml", text, 11, 8, "objects[0].file", "no-such-bunny.obj: no such file");
+}
+
+#[test]
+fn a_mesh_path_that_is_a_directory_or_a_device_says_so() {
+    let folder = scratch_dir().join("a-folder.obj");
+    std::fs::create_dir_all(&folder).expect("folder");
+    let text = sphere_scene(
+        "type = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1",
+        &format!("type = \"mesh\"\nfile = {:?}", folder.display().to_string()),
+    );
+    check("mesh-folder.toml", text, 11, 8, "objects[0].file", "is a directory");
+    let text = sphere_scene(
+        "type = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1",
+        "type = \"mesh\"\nfile = \"/dev/zero\"",
+    );
+    check(
+        "mesh-zero.toml",
+        text,
+        11,
+        8,
+        "objects[0].file",
+        "/dev/zero: is not a regular file",
+    );
+    let text = GOOD.replace("albedo = [0.5, 0.5, 0.5]", "albedo = { image = \"/dev/zero\" }");
+    check(
+        "image-zero.toml",
+        text,
+        7,
+        20,
+        "materials.white.albedo.image",
+        "is not a regular file",
+    );
+}
+
+#[test]
+fn nan_vertex_normals_are_refused() {
+    let obj = scratch_dir().join("nan-normal.obj");
+    std::fs::write(
+        &obj,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn nan 0 1\nvn 0 0 1\nf 1//1 2//2 3//3\n",
+    )
+    .expect("obj");
+    let text = sphere_scene(
+        "type = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1",
+        &format!("type = \"mesh\"\nfile = {:?}", obj.display().to_string()),
+    );
+    check(
+        "nan-normal.toml",
+        text,
+        11,
+        8,
+        "objects[0].file",
+        "a vertex normal (vn) is not finite",
+    );
+}
+
+#[test]
+fn mesh_vertices_are_checked_after_the_transform() {
+    let obj = scratch_dir().join("unit.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").expect("obj");
+    let text = sphere_scene(
+        "type = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1",
+        &format!(
+            "type = \"mesh\"\nfile = {:?}\ntransform = {{ scale = 1e12, translate = [1e12, 0, 0] }}",
+            obj.display().to_string()
+        ),
+    );
+    check(
+        "mesh-far.toml",
+        text,
+        12,
+        13,
+        "objects[0].transform",
+        "after the transform must lie within ±1e12",
+    );
+}
+
+#[test]
+fn render_settings_in_the_file_are_checked_like_the_flags() {
+    let text = format!("{GOOD}\n[render]\nmax_depth = 2147483647\n");
+    check(
+        "depth.toml",
+        text,
+        10,
+        13,
+        "render.max_depth",
+        "must be at most 1024 (found 2147483647)",
+    );
+    let text = format!("{GOOD}\n[render]\nwidth = 100000\nheight = 100000\n");
+    check("huge.toml", text, 10, 9, "render.width", "must be at most 65536 pixels");
+    let text = format!("{GOOD}\n[render]\nwidth = 60000\nheight = 60000\n");
+    check(
+        "too-much-memory.toml",
+        text,
+        10,
+        9,
+        "render.width",
+        "needs about 288.0 GB of memory",
+    );
+}
+
+/// The issue's reproducer 5 (SPPM, max_depth 2147483647, a glass triangle
+/// with a vertex at -1e308) and each of its two bad values alone.
+#[test]
+fn sppm_hang_reproducers_are_refused() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/reproducers");
+    for (file, location, field) in [
+        ("sppm_hang.toml", "14:13", "render.max_depth"),
+        ("sppm_hang_depth_only.toml", "14:13", "render.max_depth"),
+        ("sppm_hang_vertex_only.toml", "39:49", "objects[1].vertices[2][0]"),
+    ] {
+        let path = dir.join(file);
+        let started = std::time::Instant::now();
+        let (success, stderr) = run_with(&path, &[]);
+        assert!(!success && started.elapsed().as_secs() < 30, "{file}: {stderr}");
+        let expected = format!("error: {}:{location}: {field}: ", path.display());
+        assert!(stderr.starts_with(&expected), "{file}: expected {expected:?}, got {stderr:?}");
+    }
 }

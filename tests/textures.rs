@@ -284,14 +284,14 @@ fn a_missing_or_corrupt_image_is_a_located_error_naming_the_file() {
     // The albedo line is line 7: four camera lines plus the blank, then the header and type.
     let missing = load_error(&material("no-such-earth.png"));
     assert!(
-        missing.starts_with("textures.toml:7: materials.globe.albedo.image: cannot read image ")
+        missing.starts_with("textures.toml:7:20: materials.globe.albedo.image: cannot read image ")
             && missing.contains("no-such-earth.png"),
         "{missing}"
     );
     std::fs::write(scratch().join("corrupt.png"), b"\x89PNG\r\n\x1a\n this is not a PNG stream").expect("write corrupt file");
     let corrupt = load_error(&material("corrupt.png"));
     assert!(
-        corrupt.starts_with("textures.toml:7: materials.globe.albedo.image: cannot decode image ")
+        corrupt.starts_with("textures.toml:7:20: materials.globe.albedo.image: cannot decode image ")
             && corrupt.contains("corrupt.png"),
         "{corrupt}"
     );
@@ -300,7 +300,7 @@ fn a_missing_or_corrupt_image_is_a_located_error_naming_the_file() {
     std::fs::write(&scene_path, format!("{CAMERA}{}", material("gone.png"))).expect("write scene");
     let error = load_scene_file(&scene_path).err().map(|e| e.to_string()).unwrap_or_default();
     assert!(
-        error.contains("missing-image.toml:7: materials.globe.albedo.image: cannot read image") && error.contains("gone.png"),
+        error.contains("missing-image.toml:7:20: materials.globe.albedo.image: cannot read image") && error.contains("gone.png"),
         "{error}"
     );
 }
@@ -345,9 +345,15 @@ fn misplaced_or_invalid_texture_keys_are_located_errors() {
             "materials.m.albedo.checker: give only one of `image`, `checker` or `gradient`",
         ),
     ];
-    for (albedo, expected) in cases {
+    // Each error sits at the value of the key it names (the table itself for the last but one).
+    let columns = [56, 53, 63, 56, 54, 22, 62, 10, 39];
+    for ((albedo, expected), column) in cases.into_iter().zip(columns) {
         let error = load_error(&format!("[materials.m]\ntype = \"diffuse\"\nalbedo = {albedo}\n"));
-        assert_eq!(error, format!("textures.toml:7: {expected}"), "for albedo = {albedo}");
+        assert_eq!(
+            error,
+            format!("textures.toml:7:{column}: {expected}"),
+            "for albedo = {albedo}"
+        );
     }
     // A misspelt key is named by serde, with the keys it could have meant.
     let error = load_error("[materials.m]\ntype = \"diffuse\"\nalbedo = { imag = \"a.png\" }\n");

@@ -17,17 +17,80 @@ pub struct Mesh {
     pub faces: Vec<[u32; 3]>,
 }
 
+/// An OBJ file read whole: its mesh and, per face, the `.mtl` material its
+/// group uses (`usemtl`).
+#[derive(Clone, Debug)]
+pub struct ObjFile {
+    pub mesh: Mesh,
+    /// Per face of `mesh`: an index into `materials`, if its group named one.
+    pub face_materials: Vec<Option<usize>>,
+    /// The materials of the file's `mtllib` libraries, as `tobj` parsed them.
+    pub materials: Vec<tobj::Material>,
+    /// Why the material libraries could not be read, when they could not.
+    pub material_error: Option<String>,
+}
+
+/// Checks that `path` names a regular file (following links) before it is
+/// opened: a directory, a device such as /dev/zero or a pipe would make a
+/// reader fail obscurely, read forever or block.
+pub fn regular_file(path: &Path) -> Result<(), String> {
+    match std::fs::metadata(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(format!("{}: no such file", path.display())),
+        Err(e) => Err(format!("{}: cannot read: {e}", path.display())),
+        Ok(m) if m.is_dir() => Err(format!("{}: is a directory, not a file", path.display())),
+        Ok(m) if !m.is_file() => Err(format!(
+            "{}: is not a regular file (a device, pipe or socket)",
+            path.display()
+        )),
+        Ok(_) => Ok(()),
+    }
+}
+
 impl Mesh {
     /// Loads every model in an OBJ file into one mesh, triangulating polygons.
     pub fn load_obj(path: &Path, transform: &Transform) -> Result<Self, String> {
+        Ok(Self::load_obj_file(path, transform)?.mesh)
+    }
+
+    /// Loads an OBJ file with the `.mtl` materials its faces use. Vertex
+    /// positions and normals must be finite. `mtllib` paths resolve against
+    /// the OBJ file's folder and must be regular files too.
+    pub fn load_obj_file(path: &Path, transform: &Transform) -> Result<ObjFile, String> {
+        regular_file(path)?;
         let options = tobj::LoadOptions {
             triangulate: true,
             single_index: true,
             ignore_points: true,
             ignore_lines: true,
         };
-        let (models, _materials) = tobj::load_obj(path, &options).map_err(|e| format!("cannot read OBJ: {e}"))?;
+        let folder = path.parent().unwrap_or(Path::new("."));
+        let library_errors = std::cell::RefCell::new(Vec::new());
+        let load_library = |library: &Path| {
+            let full = folder.join(library);
+            if let Err(e) = regular_file(&full) {
+                library_errors.borrow_mut().push(e);
+                return Err(tobj::LoadError::OpenFileFailed);
+            }
+            tobj::load_mtl(&full).inspect_err(|e| library_errors.borrow_mut().push(format!("{}: {e}", full.display())))
+        };
+        let file = std::fs::File::open(path).map_err(|e| format!("cannot open: {e}"))?;
+        let mut reader = std::io::BufReader::new(file);
+        let (models, materials) =
+            tobj::load_obj_buf(&mut reader, &options, load_library).map_err(|e| format!("cannot read OBJ: {e}"))?;
+        let (materials, material_error) = match materials {
+            Ok(materials) => (materials, None),
+            Err(e) => {
+                let reasons = library_errors.into_inner();
+                let reason = if reasons.is_empty() {
+                    e.to_string()
+                } else {
+                    reasons.join("; ")
+                };
+                (Vec::new(), Some(reason))
+            }
+        };
         let mut mesh = Mesh::default();
+        let mut face_materials = Vec::new();
         for model in &models {
             let m = &model.mesh;
             let base = mesh.positions.len() as u32;
@@ -56,6 +119,7 @@ impl Mesh {
                     return Err("a face refers to a vertex that does not exist".into());
                 }
                 mesh.faces.push(f);
+                face_materials.push(m.material_id);
             }
         }
         // Attributes are kept only if every model supplied them.
@@ -68,11 +132,22 @@ impl Mesh {
         if mesh.faces.is_empty() {
             return Err("the OBJ file has no triangles".into());
         }
-        if mesh.positions.iter().any(|p| !p.is_finite()) {
-            return Err("the OBJ file has a non-finite vertex position".into());
+        if let Some(p) = mesh.positions.iter().find(|p| !p.is_finite()) {
+            return Err(format!("a vertex position (v) is not finite: {p}"));
+        }
+        // Normals are read even when the mesh would be flat-shaded without
+        // them; a NaN one would turn every shading frame it touches to NaN.
+        let all_normals = models.iter().flat_map(|m| m.mesh.normals.chunks_exact(3));
+        if let Some(n) = all_normals.into_iter().find(|n| n.iter().any(|c| !c.is_finite())) {
+            return Err(format!("a vertex normal (vn) is not finite: [{}, {}, {}]", n[0], n[1], n[2]));
         }
         mesh.apply(transform);
-        Ok(mesh)
+        Ok(ObjFile {
+            mesh,
+            face_materials,
+            materials,
+            material_error,
+        })
     }
 
     /// Moves the mesh into world space.

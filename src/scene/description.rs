@@ -1,11 +1,16 @@
-//! The scene file as plain data: what the user wrote, with source spans, before
-//! anything is validated or built. Documented key by key in docs/scene-format.md.
+//! The scene file as plain data: what the user wrote, before anything is
+//! validated or built. Documented key by key in docs/scene-format.md. Where
+//! each value was written is kept by the spanned document it was read from
+//! (`scene::document`), not here.
+//!
+//! Objects and materials are read as serde's externally tagged enums: the
+//! loader first rewrites each `type = "kind"` table into `{ kind = {...} }`
+//! (`Document::retagged`), which keeps the spans an internally tagged enum
+//! would lose.
 
-use crate::sampler::SamplerKind;
-use crate::settings::IntegratorKind;
+use crate::settings::SettingsPatch;
 use serde::Deserialize;
 use std::collections::BTreeMap;
-use toml::Spanned;
 
 mod texture;
 pub use texture::{ColorDescription, MappingKind, Numbers, TextureDescription, WrapKind};
@@ -16,15 +21,17 @@ pub type Vector = [f64; 3];
 #[serde(deny_unknown_fields)]
 pub struct SceneDescription {
     pub camera: CameraDescription,
+    /// The `[render]` table: the same settings, checked the same way, as the
+    /// command line's flags.
     #[serde(default)]
-    pub render: RenderDescription,
+    pub render: SettingsPatch,
     /// Radiance of rays that escape the scene (linear RGB). Default black.
     #[serde(default)]
-    pub background: Option<Spanned<Vector>>,
+    pub background: Option<Vector>,
     #[serde(default)]
-    pub materials: BTreeMap<String, Spanned<MaterialDescription>>,
+    pub materials: BTreeMap<String, MaterialDescription>,
     #[serde(default)]
-    pub objects: Vec<Spanned<ObjectDescription>>,
+    pub objects: Vec<ObjectDescription>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -53,25 +60,8 @@ fn default_fov() -> f64 {
     40.0
 }
 
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RenderDescription {
-    pub width: Option<u32>,
-    pub height: Option<u32>,
-    pub spp: Option<u32>,
-    pub max_depth: Option<u32>,
-    pub integrator: Option<IntegratorKind>,
-    pub sampler: Option<SamplerKind>,
-    pub seed: Option<u64>,
-    pub photons_per_iteration: Option<u32>,
-    pub initial_radius: Option<f64>,
-    pub alpha: Option<f64>,
-    /// Relative standard error at which a pixel stops taking samples.
-    pub adaptive_threshold: Option<f64>,
-}
-
 #[derive(Debug, Deserialize)]
-#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+#[serde(rename_all = "lowercase", deny_unknown_fields)]
 pub enum MaterialDescription {
     Diffuse {
         albedo: ColorDescription,
@@ -129,7 +119,7 @@ pub enum Scale {
 }
 
 #[derive(Debug, Deserialize)]
-#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+#[serde(rename_all = "lowercase", deny_unknown_fields)]
 pub enum ObjectDescription {
     Sphere {
         center: Vector,
@@ -153,7 +143,10 @@ pub enum ObjectDescription {
     },
     Mesh {
         file: String,
-        material: String,
+        /// The scene's material for every face; if omitted, the faces take
+        /// the materials of the OBJ file's `.mtl` library.
+        #[serde(default)]
+        material: Option<String>,
         #[serde(default)]
         transform: TransformDescription,
     },
@@ -176,14 +169,16 @@ pub enum ObjectDescription {
 }
 
 impl ObjectDescription {
-    pub fn material(&self) -> &str {
+    /// The scene material the object names; `None` for a mesh that takes
+    /// its materials from its `.mtl` library.
+    pub fn material(&self) -> Option<&str> {
         match self {
             ObjectDescription::Sphere { material, .. }
             | ObjectDescription::Box { material, .. }
             | ObjectDescription::Quad { material, .. }
             | ObjectDescription::Triangle { material, .. }
-            | ObjectDescription::Mesh { material, .. }
-            | ObjectDescription::Revolution { material, .. } => material,
+            | ObjectDescription::Revolution { material, .. } => Some(material),
+            ObjectDescription::Mesh { material, .. } => material.as_deref(),
         }
     }
 }

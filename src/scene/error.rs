@@ -1,33 +1,65 @@
-//! Scene errors that say where: file, line (when known) and field.
+//! Scene errors that say where: file, line and column (when known) and the
+//! full path of the field, e.g. `scene.toml:34:10: objects[3].radius: must be
+//! positive (found -1)`.
 
 use std::fmt;
 use std::path::PathBuf;
 
+/// Where in a text a byte offset lies: 1-based line and column (columns count
+/// characters, as editors do).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Location {
+    pub line: usize,
+    pub column: usize,
+}
+
+impl Location {
+    /// The line and column of byte `offset` in `text` (clamped to the text,
+    /// and to the start of the character it falls in).
+    pub fn of_offset(text: &str, offset: usize) -> Self {
+        let mut offset = offset.min(text.len());
+        while !text.is_char_boundary(offset) {
+            offset -= 1;
+        }
+        let before = &text[..offset];
+        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+        Self {
+            line: before.bytes().filter(|&b| b == b'\n').count() + 1,
+            column: before[line_start..].chars().count() + 1,
+        }
+    }
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct SceneError {
     pub file: PathBuf,
-    pub line: Option<usize>,
-    /// Dotted path of the offending key, e.g. `objects[3].radius`.
+    pub location: Option<Location>,
+    /// Full path of the offending key, e.g. `objects[3].radius`.
     pub field: Option<String>,
     pub message: String,
 }
 
 impl SceneError {
-    pub fn new(file: impl Into<PathBuf>, line: Option<usize>, field: Option<String>, message: impl Into<String>) -> Self {
+    pub fn new(file: impl Into<PathBuf>, location: Option<Location>, field: Option<String>, message: impl Into<String>) -> Self {
         Self {
             file: file.into(),
-            line,
+            location,
             field,
             message: message.into(),
         }
+    }
+
+    /// The 1-based line, when known.
+    pub fn line(&self) -> Option<usize> {
+        self.location.map(|l| l.line)
     }
 }
 
 impl fmt::Display for SceneError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{}", self.file.display())?;
-        if let Some(line) = self.line {
-            write!(f, ":{line}")?;
+        if let Some(Location { line, column }) = self.location {
+            write!(f, ":{line}:{column}")?;
         }
         write!(f, ": ")?;
         if let Some(field) = &self.field {
@@ -41,7 +73,16 @@ impl fmt::Display for SceneError {
 
 impl std::error::Error for SceneError {}
 
-/// 1-based line of a byte offset.
-pub fn line_of(text: &str, offset: usize) -> usize {
-    text[..offset.min(text.len())].bytes().filter(|&b| b == b'\n').count() + 1
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn columns_count_characters_from_one() {
+        let text = "a = 1\nbé = [1, x]\n";
+        let x = text.find('x').unwrap_or_default();
+        assert_eq!(Location::of_offset(text, x), Location { line: 2, column: 10 });
+        assert_eq!(Location::of_offset(text, 0), Location { line: 1, column: 1 });
+        assert_eq!(Location::of_offset(text, 10_000), Location { line: 3, column: 1 });
+    }
 }

@@ -1,16 +1,18 @@
-//! Scenes: the plain description parsed from a scene file
-//! (`description`), turned into a frozen, render-ready `Scene` (`load`)
-//! whose acceleration structure is built once and shared read-only. A
-//! description can be placed by a `similarity` (scaled and moved) before it
-//! is built.
+//! Scenes: the scene file parsed into a spanned TOML document (`document`),
+//! read as plain data (`description`), then checked and turned into a frozen,
+//! render-ready `Scene` (`load`) whose acceleration structure is built once
+//! and shared read-only. Every error names file, line, column and field
+//! (`error`). A description can be placed by a `similarity` (scaled and
+//! moved) before it is built.
 
 pub mod description;
+pub mod document;
 pub mod error;
 pub mod load;
 pub mod similarity;
 
-pub use error::SceneError;
-pub use load::{LoadedScene, load_scene_file, load_scene_str};
+pub use error::{Location, SceneError};
+pub use load::{COORDINATE_LIMIT, LoadedScene, load_scene_bytes, load_scene_file, load_scene_str, load_scene_str_edited};
 pub use similarity::{Similarity, load_scene_str_placed};
 
 use crate::accel::{BuildPrimitive, Bvh, TraversalRay};

@@ -14,11 +14,12 @@
 //! same up to rounding: radiance does not depend on scale.
 
 use super::description::{
-    CameraDescription, ColorDescription, MaterialDescription, ObjectDescription, RenderDescription, Scale, SceneDescription,
-    TextureDescription, TransformDescription, Vector,
+    CameraDescription, ColorDescription, MaterialDescription, ObjectDescription, Scale, SceneDescription, TextureDescription,
+    TransformDescription, Vector,
 };
 use super::error::SceneError;
-use super::load::{LoadedScene, build_scene, parse_scene_str};
+use super::load::{LoadedScene, load_scene_str_edited};
+use crate::settings::SettingsPatch;
 use glam::DVec3;
 use std::path::Path;
 
@@ -73,10 +74,10 @@ impl Similarity {
         self.apply_to_camera(&mut description.camera);
         self.apply_to_render(&mut description.render);
         for material in description.materials.values_mut() {
-            self.apply_to_material(material.get_mut());
+            self.apply_to_material(material);
         }
         for object in &mut description.objects {
-            self.apply_to_object(object.get_mut());
+            self.apply_to_object(object);
         }
     }
 
@@ -88,7 +89,7 @@ impl Similarity {
         camera.near_clip = self.length(camera.near_clip);
     }
 
-    fn apply_to_render(&self, render: &mut RenderDescription) {
+    fn apply_to_render(&self, render: &mut SettingsPatch) {
         render.initial_radius = render.initial_radius.map(|r| self.length(r));
     }
 
@@ -165,9 +166,7 @@ impl Similarity {
 /// errors (which point at the lines of the unplaced text), `base` resolves
 /// paths.
 pub fn load_scene_str_placed(text: &str, file: &Path, base: &Path, similarity: &Similarity) -> Result<LoadedScene, SceneError> {
-    let mut description = parse_scene_str(text, file)?;
-    similarity.apply(&mut description);
-    build_scene(description, text, file, base)
+    load_scene_str_edited(text, file, base, |description| similarity.apply(description))
 }
 
 #[cfg(test)]

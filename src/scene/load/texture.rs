@@ -1,14 +1,15 @@
 //! Colour fields → [`Texture`]s: which keys go together, value checks, and
 //! image files decoded once per load through the [`ImageCache`].
 
-use super::{Builder, find_key};
+use super::Builder;
 use crate::color::Color;
 use crate::geometry::Transform;
+use crate::geometry::mesh::regular_file;
 use crate::material::texture::{Gradient, ImageCache, Mapping, PlanarProjection, Projection, SphereProjection, Texture, Wrap};
 use crate::scene::description::{ColorDescription, MappingKind, Numbers, TextureDescription, Vector, WrapKind};
-use crate::scene::error::{SceneError, line_of};
+use crate::scene::document::FieldPath;
+use crate::scene::error::SceneError;
 use glam::{DVec2, DVec3};
-use std::ops::Range;
 
 /// Which pattern a texture table names, for messages.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -30,9 +31,7 @@ impl Pattern {
 
 /// A colour field being built: where it is written, and its largest allowed component.
 struct Field<'f> {
-    span: &'f Option<Range<usize>>,
-    path: &'f str,
-    name: &'f str,
+    path: &'f FieldPath,
     /// Diffuse albedo may not exceed 1: it would create energy.
     at_most_one: bool,
 }
@@ -41,19 +40,12 @@ impl Builder<'_> {
     /// The texture a colour field describes. `at_most_one` for albedos.
     pub(super) fn texture(
         &self,
-        span: &Option<Range<usize>>,
-        path: &str,
-        name: &str,
+        path: &FieldPath,
         color: &ColorDescription,
         at_most_one: bool,
         images: &mut ImageCache,
     ) -> Result<Texture, SceneError> {
-        let field = Field {
-            span,
-            path,
-            name,
-            at_most_one,
-        };
+        let field = Field { path, at_most_one };
         match color {
             ColorDescription::Rgb(rgb) => Ok(Texture::Constant(self.reflectance(&field, None, *rgb)?)),
             ColorDescription::Texture(table) => self.texture_table(&field, table, images),
@@ -61,18 +53,12 @@ impl Builder<'_> {
     }
 
     /// An error about `key` inside the texture table of `field` (or about the
-    /// whole field when `key` is `None`), at the line where the key is written.
+    /// whole field when `key` is `None`), placed where it is written.
     fn texture_error(&self, field: &Field, key: Option<&str>, message: impl Into<String>) -> SceneError {
-        let mut error = self.error(field.span.clone(), field.path, field.name, message);
-        if let (Some(key), Some(span)) = (key, field.span) {
-            let body = &self.text[span.start.min(self.text.len())..span.end.min(self.text.len())];
-            let field_offset = find_key(body, field.name).unwrap_or(0);
-            if let Some(key_offset) = find_key(&body[field_offset..], key) {
-                error.line = Some(line_of(self.text, span.start + field_offset + key_offset));
-            }
-            error.field = error.field.map(|f| format!("{f}.{key}"));
+        match key {
+            Some(key) => self.error(&field.path.key(key), message),
+            None => self.error(field.path, message),
         }
-        error
     }
 
     fn reflectance(&self, field: &Field, key: Option<&str>, rgb: Vector) -> Result<Color, SceneError> {
@@ -91,7 +77,12 @@ impl Builder<'_> {
     fn finite_vector(&self, field: &Field, key: &str, v: Option<Vector>) -> Result<Option<DVec3>, SceneError> {
         match v {
             Some(v) if v.iter().any(|c| !c.is_finite()) => Err(self.texture_error(field, Some(key), "must be finite numbers")),
-            v => Ok(v.map(DVec3::from_array)),
+            Some(v) => {
+                // Texture centres, origins and edges are scene positions too.
+                self.coordinates(&field.path.key(key), &v)?;
+                Ok(Some(DVec3::from_array(v)))
+            }
+            None => Ok(None),
         }
     }
 
@@ -188,6 +179,11 @@ impl Builder<'_> {
                     (None, _) => [Wrap::Repeat; 2],
                 };
                 let file = self.base.join(t.image.as_deref().unwrap_or_default());
+                // A missing file is reported by the image cache; a folder or a
+                // device (which would be read forever) is refused here.
+                if file.exists() {
+                    regular_file(&file).map_err(|e| self.texture_error(field, Some("image"), format!("image file {e}")))?;
+                }
                 let image = images
                     .load(&file)
                     .map_err(|e| self.texture_error(field, Some("image"), e.to_string()))?;
