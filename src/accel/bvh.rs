@@ -17,22 +17,33 @@
 //! kind (triangles, or other shapes), numbered within that kind.
 
 use super::bounds::{Bounds32, round_up};
-use super::build::{self, BinaryContent, BinaryNode, BuildItem};
+use super::build::{self, BinaryContent, BinaryNode, Box4, BuildItem, MAX_LEAF_SIZE};
 use crate::math::{Aabb, Ray};
+use wide::{CmpLe, f32x4};
 
 /// Children per node.
 pub const WIDTH: usize = 4;
 /// Kinds of primitive the leaves distinguish (triangles, shapes).
 pub const KIND_COUNT: usize = 2;
 
-/// Marks a child reference as a leaf (its low bits are the first primitive).
+/// A child reference is a node index, or a leaf: `LEAF_BIT`, the kind in
+/// bit 30, the primitive count − 1 in bits 28–29, the first primitive in
+/// the low 28 bits. So one 32-bit word says everything a traversal step
+/// needs, and a stack entry (reference and entry distance) is 64 bits.
 const LEAF_BIT: u32 = 1 << 31;
+const KIND_SHIFT: u32 = 30;
+const COUNT_SHIFT: u32 = 28;
+const FIRST_MASK: u32 = (1 << COUNT_SHIFT) - 1;
+/// Most primitives of one kind a BVH can index.
+pub const MAX_PRIMITIVES_PER_KIND: usize = 1 << COUNT_SHIFT;
 /// An unused child slot (its box is empty, so no ray enters it).
 const EMPTY_CHILD: u32 = u32::MAX;
 
-/// Entries of the traversal stack: a four-wide tree built with the depth
-/// bound of the builder never needs more (3 per level below the root).
-const STACK_SIZE: usize = 256;
+/// Entries of the fixed traversal stack. Each interior node visited leaves
+/// at most three siblings behind, so trees up to 21 levels deep (every
+/// scene of up to hundreds of millions of triangles in practice) traverse
+/// with it; deeper trees use a growable stack.
+const FIXED_STACK: usize = 64;
 
 /// `1 + 2γ₃` in single precision (γₙ = nu/(1 − nu), u = 2⁻²⁴), rounded up
 /// generously: a far slab distance computed with three roundings (the
@@ -47,13 +58,8 @@ struct Node {
     /// `bounds[2 * axis]` holds the children's minima on `axis`,
     /// `bounds[2 * axis + 1]` their maxima.
     bounds: [[f32; WIDTH]; 6],
-    /// Interior child: node index. Leaf: `LEAF_BIT | first primitive`.
-    /// `EMPTY_CHILD` for unused slots.
+    /// Node index or leaf reference (see `LEAF_BIT`); `EMPTY_CHILD` for unused slots.
     children: [u32; WIDTH],
-    /// Primitives in each leaf child (0 for interior or unused slots).
-    leaf_count: [u8; WIDTH],
-    /// Kind of each leaf child's primitives.
-    leaf_kind: [u8; WIDTH],
 }
 
 impl Node {
@@ -67,14 +73,13 @@ impl Node {
             [f32::NEG_INFINITY; WIDTH],
         ],
         children: [EMPTY_CHILD; WIDTH],
-        leaf_count: [0; WIDTH],
-        leaf_kind: [0; WIDTH],
     };
 
-    fn set_bounds(&mut self, lane: usize, bounds: &Bounds32) {
+    fn set_bounds(&mut self, lane: usize, bounds: &Box4) {
+        let (lower, upper) = (bounds.lower(), bounds.upper());
         for axis in 0..3 {
-            self.bounds[2 * axis][lane] = bounds.min[axis];
-            self.bounds[2 * axis + 1][lane] = bounds.max[axis];
+            self.bounds[2 * axis][lane] = lower[axis];
+            self.bounds[2 * axis + 1][lane] = upper[axis];
         }
     }
 }
@@ -100,13 +105,25 @@ pub struct Bvh {
     nodes: Vec<Node>,
     bounds: Aabb,
     leaf_count: usize,
+    /// Interior nodes on the longest path from the root.
+    depth: usize,
 }
 
 impl Bvh {
-    /// Builds over `primitives`. Returns the tree and, per kind, the order
-    /// in which the caller must store that kind's primitives: leaves index
-    /// into these per-kind lists.
+    /// Builds over `primitives` with leaves of up to four primitives.
+    /// Returns the tree and, per kind, the order in which the caller must
+    /// store that kind's primitives: leaves index into these per-kind lists.
     pub fn build(primitives: &[BuildPrimitive]) -> (Self, [Vec<u32>; KIND_COUNT]) {
+        Self::build_with_leaf_sizes(primitives, [MAX_LEAF_SIZE; KIND_COUNT])
+    }
+
+    /// As [`Bvh::build`], with leaves of kind k holding at most
+    /// `max_leaf_size[k]` primitives (1 to 4): 1 suits primitives whose
+    /// test costs far more than a box test.
+    pub fn build_with_leaf_sizes(
+        primitives: &[BuildPrimitive],
+        max_leaf_size: [usize; KIND_COUNT],
+    ) -> (Self, [Vec<u32>; KIND_COUNT]) {
         if primitives.is_empty() {
             return (
                 Self {
@@ -121,7 +138,8 @@ impl Bvh {
             .enumerate()
             .map(|(i, p)| BuildItem::new(Bounds32::enclosing(&p.bounds), i as u32, p.kind))
             .collect();
-        let binary = build::build(&mut items);
+        let max_leaf_size = max_leaf_size.map(|size| size.clamp(1, MAX_LEAF_SIZE));
+        let binary = build::build(&mut items, &max_leaf_size);
 
         // Number each kind's primitives in leaf order.
         let mut orders: [Vec<u32>; KIND_COUNT] = Default::default();
@@ -137,15 +155,16 @@ impl Bvh {
             index_within_kind: &index_within_kind,
             nodes: Vec::with_capacity(binary.len() / 2 + 1),
             leaf_count: 0,
+            depth: 0,
         };
-        collapser.node(0);
-        let bounds = binary[0].bounds.to_aabb();
-        let leaf_count = collapser.leaf_count;
+        collapser.node(0, 1);
+        let bounds = binary[0].bounds.to_bounds().to_aabb();
         (
             Self {
                 nodes: collapser.nodes,
                 bounds,
-                leaf_count,
+                leaf_count: collapser.leaf_count,
+                depth: collapser.depth,
             },
             orders,
         )
@@ -169,63 +188,154 @@ impl Bvh {
         self.bounds
     }
 
+    /// Interior nodes on the longest path from the root.
+    pub fn depth(&self) -> usize {
+        self.depth
+    }
+
     /// Visits the leaves `ray` enters, nearest first, skipping those beyond
     /// `*t_max`. `visit` tests a leaf's primitives, lowers `*t_max` to the
     /// nearest hit it finds, and returns true to end the traversal (any-hit
     /// queries stop at the first hit).
     #[inline]
-    pub fn traverse(&self, ray: &TraversalRay, t_max: &mut f64, mut visit: impl FnMut(Leaf, &mut f64) -> bool) {
+    pub fn traverse(&self, ray: &TraversalRay, t_max: &mut f64, visit: impl FnMut(Leaf, &mut f64) -> bool) {
         if self.nodes.is_empty() {
             return;
         }
+        if 3 * self.depth <= FIXED_STACK {
+            self.traverse_with(&mut FixedStack::new(), ray, t_max, visit);
+        } else {
+            self.traverse_with(&mut Vec::with_capacity(3 * self.depth), ray, t_max, visit);
+        }
+    }
+
+    #[inline(always)]
+    fn traverse_with(
+        &self,
+        stack: &mut impl TraversalStack,
+        ray: &TraversalRay,
+        t_max: &mut f64,
+        mut visit: impl FnMut(Leaf, &mut f64) -> bool,
+    ) {
         let mut limit = traversal_limit(*t_max);
-        let mut stack = [StackEntry::ROOT; STACK_SIZE];
-        let mut depth = 1;
-        while depth > 0 {
-            depth -= 1;
-            let entry = stack[depth];
-            if entry.t_near > limit {
-                continue;
-            }
-            if entry.child & LEAF_BIT != 0 {
+        // The child being visited: its reference and entry distance.
+        let mut current = 0u32;
+        loop {
+            if current & LEAF_BIT == 0 {
+                let node = &self.nodes[current as usize];
+                let (t_near, hit) = ray.enter_children(node, limit);
+                // Entered children as keys that sort by entry distance (the
+                // distance's bits lead, and they order like the non-negative
+                // floats they are); the others sort last. A sorting network
+                // orders them without data-dependent branches.
+                // (`pack | (hit − 1)` is the key when hit and all ones when not.)
+                let mut keys: [u64; WIDTH] = std::array::from_fn(|lane| {
+                    pack(node.children[lane], t_near[lane]) | u64::from((hit >> lane) & 1).wrapping_sub(1)
+                });
+                let entered = hit.count_ones() as usize;
+                if entered > 0 {
+                    sort4(&mut keys);
+                    // Leave the farther ones for later, farthest deepest; go on with the nearest.
+                    for &key in keys[1..entered].iter().rev() {
+                        stack.push(key);
+                    }
+                    current = keys[0] as u32;
+                    continue;
+                }
+            } else {
                 let leaf = Leaf {
-                    kind: entry.kind,
-                    first: entry.child & !LEAF_BIT,
-                    count: entry.count as u32,
+                    kind: ((current >> KIND_SHIFT) & 1) as u8,
+                    first: current & FIRST_MASK,
+                    count: ((current >> COUNT_SHIFT) & 3) + 1,
                 };
                 if visit(leaf, t_max) {
                     return;
                 }
                 limit = traversal_limit(*t_max);
-                continue;
             }
-            let node = &self.nodes[entry.child as usize];
-            let (t_near, hit) = ray.enter_children(node, limit);
-            // Push the children entered, farthest first, so the nearest is popped next.
-            let mut order = [0usize; WIDTH];
-            let mut entered = 0;
-            for lane in 0..WIDTH {
-                if hit[lane] {
-                    // Insertion into `order`, sorted by decreasing distance.
-                    let mut position = entered;
-                    while position > 0 && t_near[order[position - 1]] < t_near[lane] {
-                        order[position] = order[position - 1];
-                        position -= 1;
-                    }
-                    order[position] = lane;
-                    entered += 1;
+            // Next: the nearest deferred child still in front of the nearest hit.
+            loop {
+                let Some(entry) = stack.pop() else { return };
+                let (child, t_near) = unpack(entry);
+                if t_near <= limit {
+                    current = child;
+                    break;
                 }
             }
-            for &lane in &order[..entered] {
-                stack[depth] = StackEntry {
-                    child: node.children[lane],
-                    t_near: t_near[lane],
-                    count: node.leaf_count[lane],
-                    kind: node.leaf_kind[lane],
-                };
-                depth += 1;
-            }
         }
+    }
+}
+
+/// Sorts four keys ascending with five compare-exchanges (an optimal
+/// network), each a pair of conditional moves.
+#[inline(always)]
+fn sort4(keys: &mut [u64; WIDTH]) {
+    let mut exchange = |a: usize, b: usize| {
+        let (low, high) = (keys[a].min(keys[b]), keys[a].max(keys[b]));
+        keys[a] = low;
+        keys[b] = high;
+    };
+    exchange(0, 1);
+    exchange(2, 3);
+    exchange(0, 2);
+    exchange(1, 3);
+    exchange(1, 2);
+}
+
+/// A stack entry: the child reference in the low half, its entry distance's bits in the high half.
+#[inline(always)]
+fn pack(child: u32, t_near: f32) -> u64 {
+    (u64::from(t_near.to_bits()) << 32) | u64::from(child)
+}
+
+#[inline(always)]
+fn unpack(entry: u64) -> (u32, f32) {
+    (entry as u32, f32::from_bits((entry >> 32) as u32))
+}
+
+/// The traversal's stack of deferred children.
+trait TraversalStack {
+    fn push(&mut self, entry: u64);
+    fn pop(&mut self) -> Option<u64>;
+}
+
+/// A fixed array on the call stack: no allocation; 512 bytes to clear.
+struct FixedStack {
+    entries: [u64; FIXED_STACK],
+    len: usize,
+}
+
+impl FixedStack {
+    #[inline(always)]
+    fn new() -> Self {
+        Self {
+            entries: [0; FIXED_STACK],
+            len: 0,
+        }
+    }
+}
+
+impl TraversalStack for FixedStack {
+    #[inline(always)]
+    fn push(&mut self, entry: u64) {
+        self.entries[self.len] = entry;
+        self.len += 1;
+    }
+
+    #[inline(always)]
+    fn pop(&mut self) -> Option<u64> {
+        self.len = self.len.checked_sub(1)?;
+        Some(self.entries[self.len])
+    }
+}
+
+impl TraversalStack for Vec<u64> {
+    fn push(&mut self, entry: u64) {
+        Vec::push(self, entry);
+    }
+
+    fn pop(&mut self) -> Option<u64> {
+        Vec::pop(self)
     }
 }
 
@@ -242,23 +352,6 @@ fn traversal_limit(t_max: f64) -> f32 {
     (round_up(t_max) * FAR_SCALE).next_up()
 }
 
-#[derive(Clone, Copy, Debug)]
-struct StackEntry {
-    child: u32,
-    t_near: f32,
-    count: u8,
-    kind: u8,
-}
-
-impl StackEntry {
-    const ROOT: StackEntry = StackEntry {
-        child: 0,
-        t_near: 0.0,
-        count: 0,
-        kind: 0,
-    };
-}
-
 /// A ray prepared for conservative single-precision box tests.
 ///
 /// The slab distance to a plane b is (b − o)/d. Each is computed in `f32`
@@ -272,16 +365,18 @@ impl StackEntry {
 /// A zero direction component has an infinite reciprocal: the slab's
 /// distances are then ±∞ (the ray is inside it for all t or for none), or
 /// NaN when the origin lies exactly in the plane (0 · ∞). The running
-/// maximum and minimum are written as `if x > m { x } else { m }`, which
-/// keeps `m` when `x` is NaN (as the `maxps`/`minps` instructions do), so
-/// such a slab is simply not counted against the ray: conservative.
+/// maximum and minimum are the `maxps`/`minps` instructions, which keep
+/// their second operand (the running value) when the first is NaN, so such
+/// a slab is simply not counted against the ray: conservative.
 #[derive(Clone, Copy, Debug)]
 pub struct TraversalRay {
-    /// Origin for the entry planes, per axis.
-    entry_origin: [f32; 3],
-    /// Origin for the exit planes, per axis.
-    exit_origin: [f32; 3],
-    reciprocal: [f32; 3],
+    /// Per axis, splatted over the four lanes: the origin for the entry
+    /// planes, the origin for the exit planes, the reciprocal direction,
+    /// and the reciprocal times [`FAR_SCALE`] for the exit distances.
+    entry_origin: [f32x4; 3],
+    exit_origin: [f32x4; 3],
+    reciprocal: [f32x4; 3],
+    exit_reciprocal: [f32x4; 3],
     /// Index into a node's `bounds` of the entry and exit plane of each axis.
     entry_plane: [usize; 3],
     exit_plane: [usize; 3],
@@ -290,56 +385,51 @@ pub struct TraversalRay {
 impl TraversalRay {
     pub fn new(ray: &Ray) -> Self {
         let mut prepared = TraversalRay {
-            entry_origin: [0.0; 3],
-            exit_origin: [0.0; 3],
-            reciprocal: [0.0; 3],
+            entry_origin: [f32x4::ZERO; 3],
+            exit_origin: [f32x4::ZERO; 3],
+            reciprocal: [f32x4::ZERO; 3],
+            exit_reciprocal: [f32x4::ZERO; 3],
             entry_plane: [0; 3],
             exit_plane: [0; 3],
         };
         for axis in 0..3 {
-            let direction = ray.direction[axis];
             let origin = ray.origin[axis];
-            let down = super::bounds::round_down(origin);
-            let up = round_up(origin);
-            let reciprocal = (1.0 / direction) as f32;
-            prepared.reciprocal[axis] = reciprocal;
-            if reciprocal >= 0.0 {
+            let (down, up) = (super::bounds::round_down(origin), round_up(origin));
+            let reciprocal = (1.0 / ray.direction[axis]) as f32;
+            prepared.reciprocal[axis] = f32x4::splat(reciprocal);
+            // Four roundings in all ((b − o), r, r·scale, the product) stay
+            // within 1 − 4u of exact, which the 1 + 2⁻²¹ scale covers.
+            prepared.exit_reciprocal[axis] = f32x4::splat(reciprocal * FAR_SCALE);
+            let (entry, exit) = if reciprocal >= 0.0 {
                 // Enters through the minimum: (min − o)·r is smallest for the largest o.
                 prepared.entry_plane[axis] = 2 * axis;
                 prepared.exit_plane[axis] = 2 * axis + 1;
-                prepared.entry_origin[axis] = up;
-                prepared.exit_origin[axis] = down;
+                (up, down)
             } else {
                 prepared.entry_plane[axis] = 2 * axis + 1;
                 prepared.exit_plane[axis] = 2 * axis;
-                prepared.entry_origin[axis] = down;
-                prepared.exit_origin[axis] = up;
-            }
+                (down, up)
+            };
+            prepared.entry_origin[axis] = f32x4::splat(entry);
+            prepared.exit_origin[axis] = f32x4::splat(exit);
         }
         prepared
     }
 
-    /// Entry distances of the four children and which of them the ray
-    /// enters before `t_max`.
+    /// Entry distances of the four children and a bit mask (bit i for
+    /// lane i) of those the ray enters before `t_max`.
     #[inline(always)]
-    fn enter_children(&self, node: &Node, t_max: f32) -> ([f32; WIDTH], [bool; WIDTH]) {
-        let mut t_entry = [0.0f32; WIDTH];
-        let mut t_exit = [t_max; WIDTH];
+    fn enter_children(&self, node: &Node, t_max: f32) -> ([f32; WIDTH], u32) {
+        let mut t_entry = f32x4::ZERO;
+        let mut t_exit = f32x4::splat(t_max);
         for axis in 0..3 {
-            let entry_planes = &node.bounds[self.entry_plane[axis]];
-            let exit_planes = &node.bounds[self.exit_plane[axis]];
-            for lane in 0..WIDTH {
-                let enter = (entry_planes[lane] - self.entry_origin[axis]) * self.reciprocal[axis];
-                let exit = (exit_planes[lane] - self.exit_origin[axis]) * self.reciprocal[axis] * FAR_SCALE;
-                t_entry[lane] = if enter > t_entry[lane] { enter } else { t_entry[lane] };
-                t_exit[lane] = if exit < t_exit[lane] { exit } else { t_exit[lane] };
-            }
+            let entry = (f32x4::from(node.bounds[self.entry_plane[axis]]) - self.entry_origin[axis]) * self.reciprocal[axis];
+            let exit = (f32x4::from(node.bounds[self.exit_plane[axis]]) - self.exit_origin[axis]) * self.exit_reciprocal[axis];
+            // maxps/minps return their second operand when the first is NaN.
+            t_entry = entry.fast_max(t_entry);
+            t_exit = exit.fast_min(t_exit);
         }
-        let mut hit = [false; WIDTH];
-        for lane in 0..WIDTH {
-            hit[lane] = t_entry[lane] <= t_exit[lane];
-        }
-        (t_entry, hit)
+        (t_entry.to_array(), t_entry.cmp_le(t_exit).move_mask() as u32)
     }
 }
 
@@ -349,12 +439,14 @@ struct Collapser<'a> {
     index_within_kind: &'a [u32],
     nodes: Vec<Node>,
     leaf_count: usize,
+    depth: usize,
 }
 
 impl Collapser<'_> {
     /// Emits the four-wide node standing for binary node `index` (or, for
     /// a binary leaf at the root, a node with that one leaf) and returns its index.
-    fn node(&mut self, index: usize) -> u32 {
+    fn node(&mut self, index: usize, depth: usize) -> u32 {
+        self.depth = self.depth.max(depth);
         // Open the binary subtree: repeatedly replace the interior child of
         // largest area by its two children, up to four children.
         let mut children: Vec<usize> = match self.binary[index].content {
@@ -384,19 +476,18 @@ impl Collapser<'_> {
         self.nodes.push(Node::EMPTY);
         for (lane, &child) in children.iter().enumerate() {
             let binary = self.binary[child];
-            let (reference, count, kind) = match binary.content {
+            let reference = match binary.content {
                 BinaryContent::Leaf { first, count, kind } => {
                     self.leaf_count += 1;
                     let first = self.index_within_kind[first as usize];
-                    (LEAF_BIT | first, count as u8, kind)
+                    debug_assert!((first as usize) < MAX_PRIMITIVES_PER_KIND && (1..=4).contains(&count));
+                    LEAF_BIT | (u32::from(kind) << KIND_SHIFT) | ((count - 1) << COUNT_SHIFT) | first
                 }
-                BinaryContent::Interior { .. } => (self.node(child), 0, 0),
+                BinaryContent::Interior { .. } => self.node(child, depth + 1),
             };
             let node = &mut self.nodes[me];
             node.set_bounds(lane, &binary.bounds);
             node.children[lane] = reference;
-            node.leaf_count[lane] = count;
-            node.leaf_kind[lane] = kind;
         }
         me as u32
     }
@@ -452,6 +543,42 @@ mod tests {
             bvh.traverse(&traversal, &mut t_max, |leaf, t_max| {
                 for i in leaf.first..leaf.first + leaf.count {
                     let original = orders[leaf.kind as usize][i as usize] as usize;
+                    if let Some(t) = boxes[original].hit_distance(ray.origin, inverse, *t_max) {
+                        *t_max = t;
+                    }
+                }
+                false
+            });
+            assert_eq!(brute, t_max);
+        }
+    }
+
+    /// Boxes spaced geometrically along a line make the SAH peel off a few
+    /// at a time: a tree deeper than the fixed stack allows, which must
+    /// traverse (with the growable stack) to the same answers.
+    #[test]
+    fn deep_trees_traverse_with_a_growable_stack() {
+        let boxes: Vec<Aabb> = (0..400)
+            .map(|i| {
+                let x = 1.2f64.powi(i);
+                Aabb::new(DVec3::new(x, -1.0, -1.0), DVec3::new(x * 1.05, 1.0, 1.0))
+            })
+            .collect();
+        let primitives: Vec<BuildPrimitive> = boxes.iter().map(|b| BuildPrimitive { bounds: *b, kind: 0 }).collect();
+        let (bvh, orders) = Bvh::build(&primitives);
+        assert!(3 * bvh.depth() > FIXED_STACK, "depth {}", bvh.depth());
+        for i in 0..100 {
+            let origin = DVec3::new(-10.0, 0.3 * (i as f64 / 100.0) - 0.1, 0.2);
+            let ray = Ray::new(origin, DVec3::new(1.0, 0.0, 0.001 * i as f64));
+            let inverse = DVec3::ONE / ray.direction;
+            let brute = boxes
+                .iter()
+                .filter_map(|b| b.hit_distance(ray.origin, inverse, f64::INFINITY))
+                .fold(f64::INFINITY, f64::min);
+            let mut t_max = f64::INFINITY;
+            bvh.traverse(&TraversalRay::new(&ray), &mut t_max, |leaf, t_max| {
+                for k in leaf.first..leaf.first + leaf.count {
+                    let original = orders[0][k as usize] as usize;
                     if let Some(t) = boxes[original].hit_distance(ray.origin, inverse, *t_max) {
                         *t_max = t;
                     }

@@ -95,7 +95,9 @@ impl Scene {
                 kind: SHAPE_LEAF,
             }))
             .collect();
-        let (bvh, orders) = Bvh::build(&build_primitives);
+        // A leaf holds up to four triangles, but one shape: a sphere or
+        // revolution test costs several box tests, which can cull it.
+        let (bvh, orders) = Bvh::build_with_leaf_sizes(&build_primitives, [4, 1]);
         let triangle_count = triangles.len() as u32;
         let triangles = Triangles::new(&triangles, &orders[TRIANGLE_LEAF as usize], anchors);
         let mut slots: Vec<Option<Primitive>> = shapes.into_iter().map(Some).collect();
@@ -193,13 +195,15 @@ impl Scene {
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<Intersection> {
         let traversal = TraversalRay::new(ray);
-        let triangle_ray = TriangleRay::new(ray);
+        // The triangle test's per-ray constants, made when a triangle leaf is first reached.
+        let mut triangle_ray: Option<TriangleRay> = None;
         let mut nearest_triangle: Option<LeafHit> = None;
         let mut nearest_shape: Option<Intersection> = None;
         let mut t = t_max;
         self.bvh.traverse(&traversal, &mut t, |leaf, t_max| {
             if leaf.kind == TRIANGLE_LEAF {
-                if let Some(found) = self.triangles.intersect_leaf(&triangle_ray, leaf.first, leaf.count, *t_max) {
+                let triangle_ray = triangle_ray.get_or_insert_with(|| TriangleRay::new(ray));
+                if let Some(found) = self.triangles.intersect_leaf(triangle_ray, leaf.first, leaf.count, *t_max) {
                     *t_max = found.hit.t;
                     nearest_triangle = Some(found);
                     nearest_shape = None;
@@ -231,12 +235,13 @@ impl Scene {
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f64) -> bool {
         let traversal = TraversalRay::new(ray);
-        let triangle_ray = TriangleRay::new(ray);
+        let mut triangle_ray: Option<TriangleRay> = None;
         let mut t = t_max;
         let mut found = false;
         self.bvh.traverse(&traversal, &mut t, |leaf, t_max| {
             found = if leaf.kind == TRIANGLE_LEAF {
-                self.triangles.occludes_leaf(&triangle_ray, leaf.first, leaf.count, *t_max)
+                let triangle_ray = triangle_ray.get_or_insert_with(|| TriangleRay::new(ray));
+                self.triangles.occludes_leaf(triangle_ray, leaf.first, leaf.count, *t_max)
             } else {
                 (leaf.first..leaf.first + leaf.count)
                     .any(|index| self.shapes[index as usize].shape.hit_distance(ray, *t_max).is_some())
