@@ -168,6 +168,11 @@ impl ViewerApp {
 
     /// Draws one frame of the whole window into `ui`.
     pub fn show(&mut self, ui: &mut egui::Ui) {
+        self.show_timed(ui, None);
+    }
+
+    /// `show`, told how long eframe's previous whole frame took (for the log).
+    fn show_timed(&mut self, ui: &mut egui::Ui, previous_frame: Option<Duration>) {
         let began = Instant::now();
         let ctx = ui.ctx().clone();
         self.take_scene_load();
@@ -189,7 +194,7 @@ impl ViewerApp {
 
         self.sync_session();
         let stats = self.display.stats.clone();
-        self.log.frame_tick(&stats, began.elapsed());
+        self.log.frame_tick(&stats, began.elapsed(), previous_frame);
         if self.continuous_repaint {
             // The logged frame rate is then what the UI can sustain.
             ctx.request_repaint();
@@ -391,8 +396,9 @@ impl ViewerApp {
 }
 
 impl eframe::App for ViewerApp {
-    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
-        self.show(ui);
+    fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
+        let previous = frame.info().cpu_usage.map(|s| Duration::from_secs_f32(s.max(0.0)));
+        self.show_timed(ui, previous);
     }
 }
 
