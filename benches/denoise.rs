@@ -12,7 +12,7 @@
 //! Run with `cargo bench --bench denoise`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use prism::bench::error_curves::error_metrics;
+use prism::metrics::error_metrics;
 use prism::denoise::{DenoiseSettings, Guides, denoise};
 use prism::film::Frame;
 use prism::render::{RenderSettings, render_with_threads};

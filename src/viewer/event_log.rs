@@ -63,6 +63,11 @@ impl EventLog {
         }
     }
 
+    /// Notes a denoised preview and how long its filter took.
+    pub fn denoise(&self, took: Duration) {
+        self.event(&format!("denoised preview in {:.1} ms", took.as_secs_f64() * 1e3));
+    }
+
     pub fn event(&self, what: &str) {
         if self.enabled {
             eprintln!("[prism-viewer {:9.1} ms] {what}", self.launched.elapsed().as_secs_f64() * 1e3);
