@@ -77,9 +77,11 @@ fn ui_scene(app: &mut ViewerApp, ui: &mut Ui) {
         if ui.button("Reload").clicked() {
             app.load_scene(app.scene_path.clone());
         }
+    });
+    ui.horizontal(|ui| {
         egui::ComboBox::from_label("Scenes")
-            .selected_text("Recent & shipped")
-            .width(120.0)
+            .selected_text("Recent and shipped")
+            .width(170.0)
             .show_ui(ui, |ui| {
                 let mut chosen: Option<Option<PathBuf>> = None;
                 for path in &app.open.recent {
@@ -279,7 +281,7 @@ fn ui_camera(app: &mut ViewerApp, ui: &mut Ui) {
     refuse(app, refusal);
     app.camera = Some(camera);
     let reset = ui.button("Reset view").clicked();
-    ui.small("Drag: orbit · right or Shift+drag: pan camera · Ctrl+wheel: dolly · click: focus there");
+    ui.add(egui::Label::new(RichText::new("Drag: orbit · right or Shift+drag: pan camera · Ctrl+wheel: dolly · click: focus there").small()).wrap());
     if focus.dragged() || focus.has_focus() {
         app.show_focal_plane = true;
     }
