@@ -54,7 +54,10 @@ fn report_quality(loaded: &LoadedScene) {
         let denoised = denoise(&frame, &guides, &settings).expect("guides of the frame's size");
         let raw = error_metrics(&frame, &reference).expect("same size").relative_mse;
         let filtered = error_metrics(&denoised, &reference).expect("same size").relative_mse;
-        println!("denoise quality: seed {seed}: relMSE raw {raw:.5}, denoised {filtered:.5}, ratio {:.3}", filtered / raw);
+        println!(
+            "denoise quality: seed {seed}: relMSE raw {raw:.5}, denoised {filtered:.5}, ratio {:.3}",
+            filtered / raw
+        );
         raw_sum += raw;
         denoised_sum += filtered;
     }
@@ -74,7 +77,10 @@ fn bench_denoise(c: &mut Criterion) {
     report_quality(&loaded);
 
     let frame = render(&loaded, TIMING_SIZE, TIMING_SIZE, 4, 1);
-    let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("a worker thread");
+    let one_thread = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("a worker thread");
     let guides = one_thread.install(|| Guides::first_hit(&loaded.scene, &loaded.camera, TIMING_SIZE, TIMING_SIZE));
     let settings = DenoiseSettings::default();
     let mut group = c.benchmark_group("denoise");

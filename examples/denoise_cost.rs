@@ -47,7 +47,10 @@ fn main() {
     let frame = render_with_threads(&loaded.scene, &loaded.camera, &settings, None)
         .expect("worker threads")
         .frame();
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("a worker thread");
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("a worker thread");
     let denoise_settings = DenoiseSettings::default();
     pool.install(|| {
         let guides = Guides::first_hit(&loaded.scene, &loaded.camera, SIZE, SIZE);

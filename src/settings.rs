@@ -171,7 +171,15 @@ mod tests {
     fn a_region_covers_the_pixels_whose_centres_lie_inside() {
         // x ∈ [0.25, 0.5] of 8 columns spans 2.0..4.0: centres 2.5 and 3.5 → columns 2, 3.
         let region = Region::from_corners([0.5, 1.0], [0.25, 0.0]).expect("a region");
-        assert_eq!(region.pixels(8, 4), PixelRect { x0: 2, y0: 0, x1: 4, y1: 4 });
+        assert_eq!(
+            region.pixels(8, 4),
+            PixelRect {
+                x0: 2,
+                y0: 0,
+                x1: 4,
+                y1: 4
+            }
+        );
         // A sliver narrower than a pixel still renders the pixel it lies in.
         let sliver = Region::from_corners([0.51, 0.51], [0.52, 0.52]).expect("a region");
         assert_eq!(sliver.pixels(8, 4).pixel_count(), 1);

@@ -309,7 +309,10 @@ fn zooming_the_image_never_restarts_the_render() {
     harness.step();
     harness.step();
     let zoomed = harness.state().image_zoom().expect("the wheel zoomed the image");
-    assert!(harness.state().image_rect().expect("drawn").width() > image.width() * 1.5, "{zoomed}");
+    assert!(
+        harness.state().image_rect().expect("drawn").width() > image.width() * 1.5,
+        "{zoomed}"
+    );
     harness.get_by_label("1:1").click();
     harness.step();
     assert_eq!(harness.state().image_zoom(), Some(1.0), "one image pixel per screen pixel");
@@ -317,7 +320,9 @@ fn zooming_the_image_never_restarts_the_render() {
     harness.step();
     assert_eq!(harness.state().image_zoom(), None);
     // The camera and the accumulation are untouched: the same generation keeps adding passes.
-    step_until(&mut harness, "a further pass", |app| app.render_stats().passes > before.passes);
+    step_until(&mut harness, "a further pass", |app| {
+        app.render_stats().passes > before.passes
+    });
     let after = harness.state().render_stats();
     assert_eq!(after.generation, before.generation, "zoom restarted the render");
     assert_eq!(after.camera, before.camera);
@@ -381,7 +386,10 @@ fn a_scene_opens_through_the_path_field() {
         harness.step();
     };
     set_path(&mut harness, "no/such/scene.toml");
-    assert!(harness.query_by_label_contains("no such file").is_some(), "a missing file is reported");
+    assert!(
+        harness.query_by_label_contains("no such file").is_some(),
+        "a missing file is reported"
+    );
     let smallpt = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/smallpt.toml");
     set_path(&mut harness, &smallpt.display().to_string());
     step_until(&mut harness, "smallpt to load and render", |app| {

@@ -219,7 +219,10 @@ mod tests {
         for (i, (a, b)) in filtered.pixels.iter().zip(&pixels).enumerate() {
             for c in 0..3 {
                 // Only f32 rounding of the division and the weighted mean.
-                assert!((a[c] - b[c]).abs() <= 1e-5 * b[c].max(0.1), "pixel {i} channel {c}: {a:?} vs {b:?}");
+                assert!(
+                    (a[c] - b[c]).abs() <= 1e-5 * b[c].max(0.1),
+                    "pixel {i} channel {c}: {a:?} vs {b:?}"
+                );
             }
         }
     }

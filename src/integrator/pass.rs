@@ -143,7 +143,12 @@ mod tests {
     fn a_pass_over_a_rectangle_samples_only_its_pixels() {
         let mut film = Film::new(5, 4);
         let cancel = AtomicBool::new(false);
-        let rect = PixelRect { x0: 1, y0: 2, x1: 4, y1: 3 };
+        let rect = PixelRect {
+            x0: 1,
+            y0: 2,
+            x1: 4,
+            y1: 3,
+        };
         add_samples_adaptive(&mut film, rect, &cancel, None, |x, y| Color::new(x as f64, y as f64, 1.0));
         for y in 0..4 {
             for x in 0..5 {

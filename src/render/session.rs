@@ -472,7 +472,11 @@ impl Worker {
         if self.render.is_none() {
             let render = ProgressiveRender::new(&self.settings);
             // A region keeps the full image around it; coarse previews would replace it.
-            let divisors = if self.settings.region.is_some() { &[][..] } else { &PREVIEW_DIVISORS[..] };
+            let divisors = if self.settings.region.is_some() {
+                &[][..]
+            } else {
+                &PREVIEW_DIVISORS[..]
+            };
             for &divisor in divisors {
                 self.render_preview(render.integrator(), &scene, &camera, divisor);
                 if self.cancel.load(Ordering::Relaxed) {
@@ -753,7 +757,15 @@ mod tests {
         });
         let info = region.frame.expect("a frame");
         let rect = info.region.expect("a region frame");
-        assert_eq!(rect, PixelRect { x0: 6, y0: 6, x1: 12, y1: 18 });
+        assert_eq!(
+            rect,
+            PixelRect {
+                x0: 6,
+                y0: 6,
+                x1: 12,
+                y1: 18
+            }
+        );
         let counts = info.sample_counts.expect("path tracing counts samples");
         for y in 0..24 {
             for x in 0..24 {

@@ -246,9 +246,7 @@ impl ViewerApp {
                 None => texture::noise_heatmap(&info.frame),
             },
             ViewKind::Image => match (self.compare_mode, &self.reference) {
-                (CompareMode::Reference, Some(reference)) => {
-                    texture::tone_mapped(&reference.frame, self.exposure, self.tone_map)
-                }
+                (CompareMode::Reference, Some(reference)) => texture::tone_mapped(&reference.frame, self.exposure, self.tone_map),
                 (CompareMode::Difference, Some(reference)) => texture::difference_heatmap(shown, &reference.frame)
                     .unwrap_or_else(|| texture::tone_mapped(shown, self.exposure, self.tone_map)),
                 _ => texture::tone_mapped(shown, self.exposure, self.tone_map),

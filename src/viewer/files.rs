@@ -230,9 +230,8 @@ impl ViewerApp {
             }
             (None, DialogPurpose::Open) if quick => {
                 self.open.focus_path = true;
-                self.open.message = Some(
-                    "No file dialog here: type the scene's path above and press Open, or pick one from the list.".into(),
-                );
+                self.open.message =
+                    Some("No file dialog here: type the scene's path above and press Open, or pick one from the list.".into());
             }
             (None, _) => {}
         }
@@ -247,9 +246,12 @@ impl ViewerApp {
         let stats = &self.display.stats;
         let settings = &info.settings;
         // The raw image unless the denoised preview was asked for (and exists at this size).
-        let denoised = self.display.denoised.as_ref().map(|d| &d.frame).filter(|d| {
-            self.save.denoised && (d.width, d.height) == (info.frame.width, info.frame.height)
-        });
+        let denoised = self
+            .display
+            .denoised
+            .as_ref()
+            .map(|d| &d.frame)
+            .filter(|d| self.save.denoised && (d.width, d.height) == (info.frame.width, info.frame.height));
         let passes_name = if settings.integrator == crate::render::IntegratorKind::Sppm {
             "Iterations"
         } else {
@@ -269,12 +271,15 @@ impl ViewerApp {
             ("Focal distance", format!("{}", info.camera.focal_distance)),
             ("Exposure", format!("{} stops, tone map {:?}", self.exposure, self.tone_map)),
             ("Status", stats.integrator_status.clone()),
-            ("Denoised", if denoised.is_some() { "yes (display preview)" } else { "no" }.to_string()),
+            (
+                "Denoised",
+                if denoised.is_some() { "yes (display preview)" } else { "no" }.to_string(),
+            ),
         ]
         .into_iter()
         .map(|(k, v)| (k.to_string(), v))
         .collect();
-        let frame: &Frame = denoised.as_deref().unwrap_or(&info.frame);
+        let frame: &Frame = denoised.unwrap_or(&info.frame);
         self.save.message = Some(
             match crate::output::save_frame(frame, path, self.exposure, self.tone_map, &metadata) {
                 Ok(()) => {

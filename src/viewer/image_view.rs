@@ -103,7 +103,10 @@ impl ViewerApp {
             let half = area.width() / 2.0;
             (
                 Rect::from_min_size(area.min, Vec2::new(half - 2.0, area.height())),
-                Some(Rect::from_min_size(area.min + Vec2::new(half + 2.0, 0.0), Vec2::new(half - 2.0, area.height()))),
+                Some(Rect::from_min_size(
+                    area.min + Vec2::new(half + 2.0, 0.0),
+                    Vec2::new(half - 2.0, area.height()),
+                )),
             )
         } else {
             (area, None)
@@ -116,7 +119,9 @@ impl ViewerApp {
         let full_uv = Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
         match &self.display.texture {
             Some(texture) => {
-                painter.with_clip_rect(main_area).image(texture.id(), rect, full_uv, Color32::WHITE);
+                painter
+                    .with_clip_rect(main_area)
+                    .image(texture.id(), rect, full_uv, Color32::WHITE);
             }
             None => {
                 painter.rect_filled(rect, 0.0, Color32::from_gray(20));
@@ -132,7 +137,9 @@ impl ViewerApp {
         }
         if let (Some(side_area), Some(texture)) = (side_area, &self.display.side_texture) {
             let side_rect = self.zoom.place(side_area, size);
-            painter.with_clip_rect(side_area).image(texture.id(), side_rect, full_uv, Color32::WHITE);
+            painter
+                .with_clip_rect(side_area)
+                .image(texture.id(), side_rect, full_uv, Color32::WHITE);
             let label = |at: Rect, text: &str| {
                 painter.text(
                     at.left_top() + Vec2::new(8.0, 8.0),
@@ -181,8 +188,7 @@ impl ViewerApp {
         self.hovered_pixel = hover.and_then(|pos| {
             let rect = pointer_rect(pos);
             let uv = (pos - rect.min) / rect.size();
-            ((0.0..1.0).contains(&uv.x) && (0.0..1.0).contains(&uv.y))
-                .then(|| ((uv.x * size.x) as u32, (uv.y * size.y) as u32))
+            ((0.0..1.0).contains(&uv.x) && (0.0..1.0).contains(&uv.y)).then_some(((uv.x * size.x) as u32, (uv.y * size.y) as u32))
         });
 
         // The wheel zooms the image; with Ctrl it moves the camera.

@@ -74,7 +74,8 @@ impl Histogram {
         let mut black = 0;
         for p in &frame.pixels {
             let lum = luminance(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
-            if !(lum > 0.0) {
+            // Black (and NaN, which compares false) has no log.
+            if lum.is_nan() || lum <= 0.0 {
                 black += 1;
                 continue;
             }

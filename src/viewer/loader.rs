@@ -8,8 +8,8 @@ use crate::camera::Camera;
 use crate::render::RenderSettings;
 use crate::scene::{self, LoadStage, Scene};
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, Mutex, PoisonError};
 use std::sync::mpsc::{self, Receiver, Sender};
+use std::sync::{Arc, Mutex, PoisonError};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant, SystemTime};
 

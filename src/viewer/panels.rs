@@ -183,7 +183,9 @@ fn ui_render(app: &mut ViewerApp, ui: &mut Ui) {
     refuse(app, refusal);
 
     ui.add_enabled_ui(sppm, |ui| {
-        egui::CollapsingHeader::new("SPPM").default_open(sppm).show(ui, |ui| ui_sppm(app, ui));
+        egui::CollapsingHeader::new("SPPM")
+            .default_open(sppm)
+            .show(ui, |ui| ui_sppm(app, ui));
     });
 
     let (response, refusal) = inputs::slider(
@@ -281,7 +283,12 @@ fn ui_camera(app: &mut ViewerApp, ui: &mut Ui) {
     refuse(app, refusal);
     app.camera = Some(camera);
     let reset = ui.button("Reset view").clicked();
-    ui.add(egui::Label::new(RichText::new("Drag: orbit · right or Shift+drag: pan camera · Ctrl+wheel: dolly · click: focus there").small()).wrap());
+    ui.add(
+        egui::Label::new(
+            RichText::new("Drag: orbit · right or Shift+drag: pan camera · Ctrl+wheel: dolly · click: focus there").small(),
+        )
+        .wrap(),
+    );
     if focus.dragged() || focus.has_focus() {
         app.show_focal_plane = true;
     }
@@ -294,7 +301,14 @@ fn ui_camera(app: &mut ViewerApp, ui: &mut Ui) {
 
 fn ui_display(app: &mut ViewerApp, ui: &mut Ui) {
     ui.label("Display (never restarts the render)");
-    let (_, refusal) = inputs::slider(ui, &mut app.exposure, -10.0..=10.0, "Exposure (stops)", false, inputs::finite("the exposure"));
+    let (_, refusal) = inputs::slider(
+        ui,
+        &mut app.exposure,
+        -10.0..=10.0,
+        "Exposure (stops)",
+        false,
+        inputs::finite("the exposure"),
+    );
     refuse(app, refusal);
     egui::ComboBox::from_label("Tone map")
         .selected_text(format!("{:?}", app.tone_map))
@@ -329,7 +343,9 @@ fn ui_display(app: &mut ViewerApp, ui: &mut Ui) {
         }
         ViewKind::Radii => match app.display.radii_range {
             Some((low, high)) if high > low => {
-                ui.small(format!("Gather radius, log scale: dark {low:.3e} … white {high:.3e}; black = none yet."));
+                ui.small(format!(
+                    "Gather radius, log scale: dark {low:.3e} … white {high:.3e}; black = none yet."
+                ));
             }
             Some((low, _)) => {
                 ui.small(format!("Every gather radius is {low:.3e} (one colour); black = none yet."));
@@ -342,7 +358,11 @@ fn ui_display(app: &mut ViewerApp, ui: &mut Ui) {
     }
     ui.horizontal(|ui| {
         ui.label("Denoised preview");
-        for (mode, label) in [(DenoiseMode::Off, "Off"), (DenoiseMode::On, "On"), (DenoiseMode::SideBySide, "Side by side")] {
+        for (mode, label) in [
+            (DenoiseMode::Off, "Off"),
+            (DenoiseMode::On, "On"),
+            (DenoiseMode::SideBySide, "Side by side"),
+        ] {
             if ui.selectable_value(&mut app.denoise_mode, mode, label).clicked() {
                 app.request_denoise();
             }

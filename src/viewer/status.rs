@@ -39,10 +39,7 @@ pub(super) fn status_text(app: &ViewerApp, now: Instant) -> String {
         "spp"
     };
     let target = stats.target_passes.map_or("∞".to_string(), |t| t.to_string());
-    let mut parts = vec![
-        format!("{:?}", stats.state),
-        format!("{}/{target} {unit}", stats.passes),
-    ];
+    let mut parts = vec![format!("{:?}", stats.state), format!("{}/{target} {unit}", stats.passes)];
     if !stats.integrator_status.is_empty() {
         parts.push(stats.integrator_status.clone());
     }

@@ -74,11 +74,12 @@ impl Integrator for PathIntegrator {
             // A stopped pixel stays stopped (its state no longer changes), so
             // once all that are sampled are, every later pass would be empty.
             let width = self.film.width as usize;
-            let converged = |threshold| {
-                self.film.pixels.par_iter().enumerate().all(|(i, p)| {
-                    !pixels.contains((i % width) as u32, (i / width) as u32) || pass::is_converged(p, threshold)
-                })
-            };
+            let converged =
+                |threshold| {
+                    self.film.pixels.par_iter().enumerate().all(|(i, p)| {
+                        !pixels.contains((i % width) as u32, (i / width) as u32) || pass::is_converged(p, threshold)
+                    })
+                };
             self.converged = self.adaptive_threshold.is_some_and(converged);
         }
         completed
