@@ -12,9 +12,9 @@
 //! Run with `cargo bench --bench denoise`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use prism::metrics::error_metrics;
 use prism::denoise::{DenoiseSettings, Guides, denoise};
 use prism::film::Frame;
+use prism::metrics::error_metrics;
 use prism::render::{RenderSettings, render_with_threads};
 use prism::scene::{LoadedScene, load_scene_file};
 use std::hint::black_box;

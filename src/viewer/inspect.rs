@@ -2,9 +2,9 @@
 //! luminance histogram and the comparison with a reference image. Plain
 //! functions of frames, so they are tested without a window.
 
-use crate::metrics::{ErrorMetrics, error_metrics};
 use crate::color::luminance;
 use crate::film::Frame;
+use crate::metrics::{ErrorMetrics, error_metrics};
 use crate::render::session::FrameInfo;
 use glam::DVec3;
 
