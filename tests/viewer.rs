@@ -356,7 +356,7 @@ fn a_typed_value_beyond_the_sliders_range_is_kept() {
     let mut harness = start(None);
     step_until(&mut harness, "the scene", |app| app.scene().is_some());
     harness.step();
-    // The drag range of "Max depth" ends at 64; the scene format allows any depth ≥ 1.
+    // The drag range of "Max depth" ends at 64; the scene format and --max-depth allow 1 to 1024.
     let field = slider_field(&harness, "Max depth");
     type_into(&mut harness, field, "100");
     assert_eq!(harness.state().settings().max_depth, 100, "the typed depth is kept");
@@ -368,7 +368,7 @@ fn a_typed_value_beyond_the_sliders_range_is_kept() {
     type_into(&mut harness, field, "0");
     assert_eq!(harness.state().settings().max_depth, 100);
     assert!(
-        harness.query_by_label_contains("max depth must be at least 1").is_some(),
+        harness.query_by_label_contains("max_depth: must be at least 1").is_some(),
         "the refusal is shown"
     );
 }

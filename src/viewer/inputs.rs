@@ -5,6 +5,8 @@
 //! typed value outside those limits is refused, the old value stays, and the
 //! reason is shown.
 
+use crate::settings::RenderSettings;
+use crate::settings::validate::{self, SettingError, SettingsPatch};
 use egui::emath::Numeric;
 use egui::{DragValue, Response, Slider, SliderClamping, Ui};
 use std::ops::RangeInclusive;
@@ -57,24 +59,40 @@ fn accept<T: Numeric>(value: &mut T, edited: T, check: impl Fn(T) -> Result<(), 
     }
 }
 
-/// A whole number of at least 1 (the scene format's `spp`, `max_depth`, `photons_per_iteration`).
-pub fn at_least_one(field: &'static str) -> impl Fn(u32) -> Result<(), String> {
-    move |v| {
-        if v >= 1 {
-            Ok(())
-        } else {
-            Err(format!("{field} must be at least 1"))
-        }
+/// The render settings' own validation (`settings::validate`, the one the
+/// scene file's `[render]` table and `prism render` go through): `patch`
+/// turns the typed value into the field it sets.
+pub fn setting<T>(patch: impl Fn(T) -> SettingsPatch) -> impl Fn(T) -> Result<(), String> {
+    move |value| {
+        patch(value)
+            .apply_to(&mut RenderSettings::default())
+            .map_err(|error| describe(&error))
     }
 }
 
-/// A positive finite number (the scene format's `initial_radius`, `--time`).
+/// A render-time limit, checked as `--time` is.
+pub fn time_limit(seconds: f64) -> Result<(), String> {
+    validate::time_limit(seconds).map(|_| ()).map_err(|error| describe(&error))
+}
+
+/// An exposure, checked as `--exposure` is.
+pub fn exposure(stops: f64) -> Result<(), String> {
+    validate::exposure(stops).map(|_| ()).map_err(|error| describe(&error))
+}
+
+/// A setting's error as the scene file names it (`max_depth: must be …`), or
+/// as the command line does for settings only it has.
+fn describe(error: &SettingError) -> String {
+    format!("{}: {}", error.setting.key().unwrap_or(error.setting.flag()), error.message)
+}
+
+/// A positive finite number (a focal distance).
 pub fn positive(field: &'static str) -> impl Fn(f64) -> Result<(), String> {
     move |v| {
         if v.is_finite() && v > 0.0 {
             Ok(())
         } else {
-            Err(format!("{field} must be a positive finite number (got {v})"))
+            Err(format!("{field} must be a positive finite number (found {v})"))
         }
     }
 }
@@ -85,29 +103,7 @@ pub fn not_negative(field: &'static str) -> impl Fn(f64) -> Result<(), String> {
         if v.is_finite() && v >= 0.0 {
             Ok(())
         } else {
-            Err(format!("{field} must be a finite number of at least 0 (got {v})"))
-        }
-    }
-}
-
-/// Strictly between 0 and 1 (SPPM's alpha, as `--alpha` checks it).
-pub fn open_unit_interval(field: &'static str) -> impl Fn(f64) -> Result<(), String> {
-    move |v| {
-        if v > 0.0 && v < 1.0 {
-            Ok(())
-        } else {
-            Err(format!("{field} must be strictly between 0 and 1 (got {v})"))
-        }
-    }
-}
-
-/// Any finite number (the exposure in stops).
-pub fn finite(field: &'static str) -> impl Fn(f64) -> Result<(), String> {
-    move |v| {
-        if v.is_finite() {
-            Ok(())
-        } else {
-            Err(format!("{field} must be a finite number"))
+            Err(format!("{field} must be a finite number of at least 0 (found {v})"))
         }
     }
 }
@@ -118,15 +114,39 @@ mod tests {
 
     #[test]
     fn valid_values_are_taken_and_invalid_ones_refused() {
+        let depth_check = || {
+            setting(|depth| SettingsPatch {
+                max_depth: Some(depth),
+                ..Default::default()
+            })
+        };
         let mut depth = 64u32;
-        assert_eq!(accept(&mut depth, 2_147_483_647, at_least_one("max depth")), None);
-        assert_eq!(depth, 2_147_483_647, "beyond the slider, within the format's limit: kept");
-        let refusal = accept(&mut depth, 0, at_least_one("max depth"));
-        assert!(refusal.is_some_and(|r| r.contains("at least 1")));
-        assert_eq!(depth, 2_147_483_647, "the old value stays");
+        assert_eq!(accept(&mut depth, 1000, depth_check()), None);
+        assert_eq!(depth, 1000, "beyond the slider, within the format's limit: kept");
+        let refusal = accept(&mut depth, 0, depth_check());
+        assert!(refusal.is_some_and(|r| r.starts_with("max_depth: must be at least 1")));
+        assert_eq!(depth, 1000, "the old value stays");
+        assert!(accept(&mut depth, 5000, depth_check()).is_some_and(|r| r.contains("at most")));
+        let radius_check = || {
+            setting(|radius| SettingsPatch {
+                initial_radius: Some(radius),
+                ..Default::default()
+            })
+        };
         let mut radius = 0.5;
-        assert!(accept(&mut radius, -5.0, positive("initial radius")).is_some());
+        assert!(accept(&mut radius, -5.0, radius_check()).is_some_and(|r| r.starts_with("initial_radius")));
         assert_eq!(radius, 0.5);
-        assert!(accept(&mut radius, 1.0, open_unit_interval("alpha")).is_some());
+        assert!(
+            accept(
+                &mut 0.5,
+                1.0,
+                setting(|alpha| SettingsPatch {
+                    alpha: Some(alpha),
+                    ..Default::default()
+                })
+            )
+            .is_some()
+        );
+        assert!(accept(&mut 60.0, -1.0, time_limit).is_some());
     }
 }

@@ -10,6 +10,7 @@ use super::inspect::{HISTOGRAM_BINS, Histogram};
 use crate::film::ToneMap;
 use crate::render::IntegratorKind;
 use crate::render::session::{Command, SessionState};
+use crate::settings::SettingsPatch;
 use egui::{Color32, Response, RichText, Ui};
 use std::path::PathBuf;
 use std::time::Duration;
@@ -156,7 +157,17 @@ fn ui_render(app: &mut ViewerApp, ui: &mut Ui) {
     ui.horizontal(|ui| {
         let label = ui.label(if sppm { "Target iterations" } else { "Target samples/pixel" });
         let mut target = app.settings.samples_per_pixel.unwrap_or(256);
-        let (response, refusal) = inputs::number(ui, &mut target, 4.0, "", !unlimited, inputs::at_least_one("the target"));
+        let (response, refusal) = inputs::number(
+            ui,
+            &mut target,
+            4.0,
+            "",
+            !unlimited,
+            inputs::setting(|value| SettingsPatch {
+                spp: Some(value),
+                ..Default::default()
+            }),
+        );
         response.labelled_by(label.id);
         ui.checkbox(&mut unlimited, "unlimited");
         app.settings.samples_per_pixel = (!unlimited).then_some(target);
@@ -166,7 +177,7 @@ fn ui_render(app: &mut ViewerApp, ui: &mut Ui) {
         let mut limited = app.settings.time_limit.is_some();
         let mut seconds = app.settings.time_limit.map_or(60.0, |t| t.as_secs_f64());
         let label = ui.checkbox(&mut limited, "Time limit");
-        let (response, refusal) = inputs::number(ui, &mut seconds, 1.0, " s", limited, inputs::positive("the time limit"));
+        let (response, refusal) = inputs::number(ui, &mut seconds, 1.0, " s", limited, inputs::time_limit);
         response.labelled_by(label.id);
         app.settings.time_limit = limited.then(|| Duration::from_secs_f64(seconds));
         refuse(app, refusal);
@@ -177,7 +188,10 @@ fn ui_render(app: &mut ViewerApp, ui: &mut Ui) {
         1..=64,
         "Max depth",
         false,
-        inputs::at_least_one("max depth"),
+        inputs::setting(|value| SettingsPatch {
+            max_depth: Some(value),
+            ..Default::default()
+        }),
     );
     track(app, &response);
     refuse(app, refusal);
@@ -188,18 +202,24 @@ fn ui_render(app: &mut ViewerApp, ui: &mut Ui) {
             .show(ui, |ui| ui_sppm(app, ui));
     });
 
+    // The scaled image must pass the same size and memory checks as a scene's own.
+    let (width, height) = (app.settings.width, app.settings.height);
     let (response, refusal) = inputs::slider(
         ui,
         &mut app.resolution_scale,
         0.1..=2.0,
         "Resolution scale",
         false,
-        |scale: f32| {
-            if scale.is_finite() && scale > 0.0 && scale <= 8.0 {
-                Ok(())
-            } else {
-                Err(format!("the resolution scale must be in (0, 8] (got {scale})"))
+        move |scale: f32| {
+            if !(scale.is_finite() && scale > 0.0) {
+                return Err(format!("the resolution scale must be a positive number (found {scale})"));
             }
+            let scaled = |side: u32| ((side as f32 * scale).round() as u32).max(1);
+            inputs::setting(|_: ()| SettingsPatch {
+                width: Some(scaled(width)),
+                height: Some(scaled(height)),
+                ..Default::default()
+            })(())
         },
     );
     track(app, &response);
@@ -222,7 +242,10 @@ fn ui_sppm(app: &mut ViewerApp, ui: &mut Ui) {
         1_000..=5_000_000,
         "Photons / iteration",
         true,
-        inputs::at_least_one("photons per iteration"),
+        inputs::setting(|value| SettingsPatch {
+            photons_per_iteration: Some(value),
+            ..Default::default()
+        }),
     );
     refuse(app, refusal);
     let (alpha, refusal) = inputs::slider(
@@ -231,7 +254,10 @@ fn ui_sppm(app: &mut ViewerApp, ui: &mut Ui) {
         0.05..=0.95,
         "Alpha",
         false,
-        inputs::open_unit_interval("alpha"),
+        inputs::setting(|value| SettingsPatch {
+            alpha: Some(value),
+            ..Default::default()
+        }),
     );
     refuse(app, refusal);
     let distance = app.home_distance();
@@ -246,7 +272,10 @@ fn ui_sppm(app: &mut ViewerApp, ui: &mut Ui) {
                 distance * 1e-4..=distance * 0.1,
                 "Initial radius",
                 true,
-                inputs::positive("the initial radius"),
+                inputs::setting(|value| SettingsPatch {
+                    initial_radius: Some(value),
+                    ..Default::default()
+                }),
             )
         })
         .inner;
@@ -307,7 +336,7 @@ fn ui_display(app: &mut ViewerApp, ui: &mut Ui) {
         -10.0..=10.0,
         "Exposure (stops)",
         false,
-        inputs::finite("the exposure"),
+        inputs::exposure,
     );
     refuse(app, refusal);
     egui::ComboBox::from_label("Tone map")
