@@ -4,7 +4,8 @@
 //! scene file → [`scene::description`] (plain data with spans) →
 //! [`scene::Scene`] (shapes, materials, lights, BVH; frozen) →
 //! an [`integrator::Integrator`] (path tracing or SPPM) rendering passes →
-//! [`film::Frame`] → image file ([`output`]), viewer texture or benchmark error.
+//! [`film::Frame`] → image file ([`output`]), viewer texture or benchmark error
+//! (the viewer may show a [`denoise`]d copy; the film is never filtered).
 //! [`render::ProgressiveRender`] is the one progressive driver the CLI, the
 //! viewer and the benchmarks share.
 
@@ -14,6 +15,7 @@ pub mod accel;
 pub mod bench;
 pub mod camera;
 pub mod color;
+pub mod denoise;
 pub mod film;
 pub mod geometry;
 pub mod integrator;

@@ -62,6 +62,70 @@ pub struct RenderSettings {
     /// standard error falls below this (see `integrator::pass::ADAPTIVE_*`);
     /// `None` samples every pixel every pass.
     pub adaptive_threshold: Option<f64>,
+    /// Render only this part of the image (the viewer's region render);
+    /// `None` renders the whole frame. Pixels outside it get no samples.
+    pub region: Option<Region>,
+}
+
+/// A rectangle of the image in film coordinates ([0, 1]², y down), so it
+/// keeps its place whatever the resolution (previews, resolution scale).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Region {
+    pub min: [f64; 2],
+    pub max: [f64; 2],
+}
+
+impl Region {
+    /// The region between two corners in any order, clipped to the image;
+    /// `None` if nothing of it is left.
+    pub fn from_corners(a: [f64; 2], b: [f64; 2]) -> Option<Self> {
+        let clip = |v: f64| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
+        let min = [clip(a[0].min(b[0])), clip(a[1].min(b[1]))];
+        let max = [clip(a[0].max(b[0])), clip(a[1].max(b[1]))];
+        (max[0] > min[0] && max[1] > min[1]).then_some(Self { min, max })
+    }
+
+    /// The pixels of a `width` × `height` image whose centres it covers, at least one.
+    pub fn pixels(&self, width: u32, height: u32) -> PixelRect {
+        let span = |min: f64, max: f64, size: u32| {
+            let first = ((min * size as f64 - 0.5).ceil().max(0.0) as u32).min(size.saturating_sub(1));
+            let end = ((max * size as f64 - 0.5).floor() as i64 + 1).clamp(first as i64 + 1, size.max(1) as i64) as u32;
+            (first, end)
+        };
+        let (x0, x1) = span(self.min[0], self.max[0], width);
+        let (y0, y1) = span(self.min[1], self.max[1], height);
+        PixelRect { x0, y0, x1, y1 }
+    }
+}
+
+/// A half-open rectangle of pixels: columns `x0..x1`, rows `y0..y1`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PixelRect {
+    pub x0: u32,
+    pub y0: u32,
+    pub x1: u32,
+    pub y1: u32,
+}
+
+impl PixelRect {
+    /// The whole `width` × `height` image.
+    pub fn full(width: u32, height: u32) -> Self {
+        Self {
+            x0: 0,
+            y0: 0,
+            x1: width,
+            y1: height,
+        }
+    }
+
+    #[inline]
+    pub fn contains(&self, x: u32, y: u32) -> bool {
+        (self.x0..self.x1).contains(&x) && (self.y0..self.y1).contains(&y)
+    }
+
+    pub fn pixel_count(&self) -> usize {
+        (self.x1 - self.x0) as usize * (self.y1 - self.y0) as usize
+    }
 }
 
 impl Default for RenderSettings {
@@ -77,6 +141,7 @@ impl Default for RenderSettings {
             seed: 0,
             sppm: SppmSettings::default(),
             adaptive_threshold: None,
+            region: None,
         }
     }
 }
@@ -88,5 +153,38 @@ impl RenderSettings {
 
     pub fn pixel_count(&self) -> usize {
         self.width as usize * self.height as usize
+    }
+
+    /// The pixels a pass samples: the region's, or the whole image.
+    pub fn sampled_pixels(&self) -> PixelRect {
+        self.region.map_or(PixelRect::full(self.width, self.height), |r| {
+            r.pixels(self.width, self.height)
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_region_covers_the_pixels_whose_centres_lie_inside() {
+        // x ∈ [0.25, 0.5] of 8 columns spans 2.0..4.0: centres 2.5 and 3.5 → columns 2, 3.
+        let region = Region::from_corners([0.5, 1.0], [0.25, 0.0]).expect("a region");
+        assert_eq!(
+            region.pixels(8, 4),
+            PixelRect {
+                x0: 2,
+                y0: 0,
+                x1: 4,
+                y1: 4
+            }
+        );
+        // A sliver narrower than a pixel still renders the pixel it lies in.
+        let sliver = Region::from_corners([0.51, 0.51], [0.52, 0.52]).expect("a region");
+        assert_eq!(sliver.pixels(8, 4).pixel_count(), 1);
+        assert!(sliver.pixels(8, 4).contains(4, 2));
+        assert_eq!(Region::from_corners([0.3, 0.3], [0.3, 0.9]), None);
+        assert_eq!(Region::from_corners([1.2, 1.5], [1.3, 2.0]), None);
     }
 }

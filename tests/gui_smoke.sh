@@ -4,7 +4,9 @@
 # screenshot of the screen and fails if the image region is blank or uniform
 # (ImageMagick's standard deviation of the cropped region), or if the viewer
 # died. Prints the viewer's timing log (PRISM_VIEWER_LOG=2: events, and the
-# frame rate the UI sustains while repainting continuously).
+# frame rate the UI sustains while repainting continuously) and each of its
+# threads' CPU time and run-queue wait (see docs/viewer.md, "Where the frame
+# time goes").
 #
 # Environment: PRISM_BIN (default: builds and uses target/debug/prism),
 # SCREENSHOT (default: target/gui-smoke/viewer.png), SETTLE_SECONDS (default 4).
@@ -31,7 +33,7 @@ screenshot=${SCREENSHOT:-target/gui-smoke/viewer.png}
 settle=${SETTLE_SECONDS:-4}
 mkdir -p "$(dirname "$screenshot")"
 log=$(mktemp)
-trap 'rm -f "$log"' EXIT
+trap 'rm -f "$log" "$log.threads"' EXIT
 
 export bin screenshot settle log
 # Mesa's software rasteriser; one thread so the renderer keeps the cores.
@@ -50,12 +52,21 @@ xvfb-run -a -s "-screen 0 1280x800x24" bash -c '
         exit 1
     fi
     import -window root "$screenshot"
+    # Where the CPU went: each thread of the viewer (the UI thread, the Mesa
+    # llvmpipe rasteriser, the render workers) with its time on a CPU and its
+    # time waiting for one since it started (Linux schedstat).
+    for task in /proc/"$pid"/task/*; do
+        read -r run wait _ < "$task/schedstat" || continue
+        printf "gui_smoke: thread %-18s on a CPU %6d ms, waiting for one %6d ms\n" \
+            "$(cat "$task/comm")" $((run / 1000000)) $((wait / 1000000)) >>"$log.threads"
+    done
     kill "$pid"
     wait "$pid" 2>/dev/null || true
 ' || { echo "gui_smoke: FAILED (viewer log follows)"; cat "$log"; exit 1; }
 
 echo "gui_smoke: viewer log:"
 cat "$log"
+cat "$log.threads" 2>/dev/null || true
 grep -q "first image shown" "$log" || { echo "gui_smoke: FAILED: no image was shown"; exit 1; }
 
 # The window opens at the top-left of the 1280x800 screen at 1200x760; the

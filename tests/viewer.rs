@@ -1,7 +1,10 @@
 //! The viewer driven through egui_kittest (no window, real render thread):
 //! the aperture slider reaches the render thread and restarts accumulation,
 //! clicking the image focuses on the clicked surface, saving writes a valid
-//! image with metadata, and a broken scene shows its error in the window.
+//! image with metadata, a broken scene shows its error in the window, Stop
+//! and Resume keep the samples, zooming never restarts the render, a typed
+//! value beyond a slider's range is kept (and an invalid one refused), and a
+//! scene opens through the path field.
 //!
 //! The renders run at 1/8 of the default scene's resolution (64 × 64) on one
 //! worker thread, so each test takes a few seconds in a debug build.
@@ -28,11 +31,12 @@ fn start(scene: Option<PathBuf>) -> Harness<'static, ViewerApp> {
         resolution_scale: 0.125,
         log: false,
         continuous_repaint: false,
+        recent_file: None,
     };
     // The render thread's wake-ups go to a context of their own: the test steps the UI itself.
     let app = ViewerApp::new(&egui::Context::default(), start, Instant::now()).expect("viewer starts");
     Harness::builder()
-        .with_size(Vec2::new(1100.0, 720.0))
+        .with_size(Vec2::new(1200.0, 1100.0))
         .build_ui_state(|ui, app: &mut ViewerApp| app.show(ui), app)
 }
 
@@ -137,7 +141,7 @@ fn clicking_the_image_focuses_on_the_clicked_surface() {
     let initial_focus = harness.state().camera().expect("camera").focal_distance;
 
     // The glass sphere's centre projects to about (0.64, 0.74) of the image.
-    let rect = harness.get_by_role_and_label(Role::Image, "Rendered image").rect();
+    let rect = harness.state().image_rect().expect("the image is drawn");
     let click = rect.lerp_inside(Vec2::new(0.64, 0.72));
     harness.event(Event::PointerMoved(click));
     press(&harness, click, true);
@@ -193,10 +197,12 @@ fn save_writes_a_valid_image_with_metadata() {
     let _ = std::fs::remove_file(&path);
 
     // The path field (the fallback when no file dialog can open), then Save.
-    let field = harness.get_by_role(Role::TextInput);
+    let field = harness.get_by_role_and_label(Role::TextInput, "Snapshot path");
     field.focus();
     harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::A);
-    harness.get_by_role(Role::TextInput).type_text(&path.display().to_string());
+    harness
+        .get_by_role_and_label(Role::TextInput, "Snapshot path")
+        .type_text(&path.display().to_string());
     harness.step();
     harness.get_by_label("Save").click();
     harness.step();
@@ -263,4 +269,132 @@ fn broken_scene_shows_its_error_in_the_window() {
     );
     assert!(harness.state().displayed_frame().is_none());
     let _ = std::fs::remove_file(&path);
+}
+
+#[test]
+fn stop_and_resume_keep_the_samples() {
+    let mut harness = start(None);
+    step_until(&mut harness, "two passes", |app| app.render_stats().passes >= 2);
+    harness.get_by_label("Stop").click();
+    step_until(&mut harness, "the stop", |app| {
+        app.render_stats().state == SessionState::Stopped
+    });
+    harness.step();
+    let stopped = harness.state().render_stats();
+    assert!(stopped.passes >= 2, "Stop kept the samples: {stopped:?}");
+    harness.get_by_label("Resume").click();
+    step_until(&mut harness, "more passes after Resume", |app| {
+        app.render_stats().passes > stopped.passes
+    });
+    let resumed = harness.state().render_stats();
+    assert_eq!(resumed.generation, stopped.generation, "the same accumulation continues");
+}
+
+#[test]
+fn zooming_the_image_never_restarts_the_render() {
+    let mut harness = start(None);
+    step_until(&mut harness, "a full-resolution frame", |app| {
+        app.displayed_frame().is_some_and(|f| !f.preview && f.passes >= 1)
+    });
+    let before = harness.state().render_stats();
+    let image = harness.state().image_rect().expect("the image is drawn");
+    harness.event(Event::PointerMoved(image.center()));
+    harness.event(Event::MouseWheel {
+        unit: egui::MouseWheelUnit::Point,
+        delta: Vec2::new(0.0, 120.0),
+        phase: egui::TouchPhase::Move,
+        source: egui::MouseWheelSource::Wheel,
+        modifiers: Modifiers::NONE,
+    });
+    harness.step();
+    harness.step();
+    let zoomed = harness.state().image_zoom().expect("the wheel zoomed the image");
+    assert!(
+        harness.state().image_rect().expect("drawn").width() > image.width() * 1.5,
+        "{zoomed}"
+    );
+    harness.get_by_label("1:1").click();
+    harness.step();
+    assert_eq!(harness.state().image_zoom(), Some(1.0), "one image pixel per screen pixel");
+    harness.get_by_label("Fit").click();
+    harness.step();
+    assert_eq!(harness.state().image_zoom(), None);
+    // The camera and the accumulation are untouched: the same generation keeps adding passes.
+    step_until(&mut harness, "a further pass", |app| {
+        app.render_stats().passes > before.passes
+    });
+    let after = harness.state().render_stats();
+    assert_eq!(after.generation, before.generation, "zoom restarted the render");
+    assert_eq!(after.camera, before.camera);
+}
+
+/// The number field of the slider labelled `label` (the spin button on its row).
+fn slider_field(harness: &Harness<'static, ViewerApp>, label: &str) -> egui::Rect {
+    let slider = harness.get_by_role_and_label(Role::Slider, label).rect();
+    harness
+        .get_all_by_role(Role::SpinButton)
+        .map(|node| node.rect())
+        .find(|r| r.center().y > slider.top() && r.center().y < slider.bottom() && r.left() >= slider.right() - 1.0)
+        .expect("the slider's number field")
+}
+
+fn type_into(harness: &mut Harness<'static, ViewerApp>, field: egui::Rect, text: &str) {
+    // A click on a number field edits it.
+    harness.event(Event::PointerMoved(field.center()));
+    press(harness, field.center(), true);
+    press(harness, field.center(), false);
+    harness.step();
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::A);
+    harness.event(Event::Text(text.to_string()));
+    harness.key_press(egui::Key::Enter);
+    harness.step();
+    harness.step();
+}
+
+#[test]
+fn a_typed_value_beyond_the_sliders_range_is_kept() {
+    let mut harness = start(None);
+    step_until(&mut harness, "the scene", |app| app.scene().is_some());
+    harness.step();
+    // The drag range of "Max depth" ends at 64; the scene format and --max-depth allow 1 to 1024.
+    let field = slider_field(&harness, "Max depth");
+    type_into(&mut harness, field, "100");
+    assert_eq!(harness.state().settings().max_depth, 100, "the typed depth is kept");
+    step_until(&mut harness, "the render thread's depth", |app| {
+        app.render_stats().settings.max_depth == 100
+    });
+    // Zero is outside the format's limits: refused, the old value stays, and the window says why.
+    let field = slider_field(&harness, "Max depth");
+    type_into(&mut harness, field, "0");
+    assert_eq!(harness.state().settings().max_depth, 100);
+    assert!(
+        harness.query_by_label_contains("max_depth: must be at least 1").is_some(),
+        "the refusal is shown"
+    );
+}
+
+#[test]
+fn a_scene_opens_through_the_path_field() {
+    let mut harness = start(None);
+    step_until(&mut harness, "the default scene", |app| app.scene().is_some());
+    let set_path = |harness: &mut Harness<'static, ViewerApp>, text: &str| {
+        harness.get_by_role_and_label(Role::TextInput, "Scene path").focus();
+        harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::A);
+        harness.get_by_role_and_label(Role::TextInput, "Scene path").type_text(text);
+        harness.step();
+        harness.get_by_label("Open").click();
+        harness.step();
+    };
+    set_path(&mut harness, "no/such/scene.toml");
+    assert!(
+        harness.query_by_label_contains("no such file").is_some(),
+        "a missing file is reported"
+    );
+    let smallpt = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/smallpt.toml");
+    set_path(&mut harness, &smallpt.display().to_string());
+    step_until(&mut harness, "smallpt to load and render", |app| {
+        // smallpt is 512 × 384: 64 × 48 at the tests' resolution scale.
+        app.scene_name().ends_with("smallpt.toml") && app.displayed_frame().is_some_and(|f| f.frame.height == 48)
+    });
+    assert_eq!(harness.state().scene_error(), None);
 }

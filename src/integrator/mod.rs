@@ -59,6 +59,20 @@ pub trait Integrator: Send {
     fn gather_radii(&self) -> Option<Vec<f32>> {
         None
     }
+
+    /// Whether [`frame`](Integrator::frame) carries a per-pixel noise
+    /// estimate (`Frame::noise`): an average of independent samples has one,
+    /// a progressive density estimate (whose samples are neither independent
+    /// nor identically distributed) has none.
+    fn estimates_noise(&self) -> bool {
+        true
+    }
+
+    /// Samples taken per pixel (row-major) where they differ between pixels
+    /// or are not simply the pass count; `None` if unknown.
+    fn sample_counts(&self) -> Option<Vec<u32>> {
+        None
+    }
 }
 
 /// The integrator the settings ask for.

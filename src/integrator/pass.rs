@@ -7,9 +7,13 @@
 //! start of a pass, so the image stays a pure function of the seed whatever
 //! the thread count; and since a stopped pixel's state no longer changes, it
 //! stays stopped, so each pixel's samples are a prefix of its sequence.
+//!
+//! A pass may cover only a rectangle of the image (the viewer's region
+//! render); pixels outside it are left as they are.
 
 use crate::color::{Color, luminance};
 use crate::film::{Film, PixelAccumulator};
+use crate::settings::PixelRect;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
@@ -37,44 +41,49 @@ pub fn is_converged(pixel: &PixelAccumulator, threshold: f64) -> bool {
 
 /// Adds one sample to every pixel: `sample(x, y)`. Returns false if cancelled.
 pub fn add_samples(film: &mut Film, cancel: &AtomicBool, sample: impl Fn(u32, u32) -> Color + Sync) -> bool {
+    let pixels = PixelRect::full(film.width, film.height);
     // `|_| true` is inlined away: the non-adaptive loop costs what it did.
-    add_samples_where(film, cancel, |_| true, sample)
+    add_samples_where(film, pixels, cancel, |_| true, sample)
 }
 
-/// Adds one sample to each pixel that adaptive sampling with `threshold`
-/// has not stopped (see [`is_converged`]); `None` samples every pixel.
+/// Adds one sample to each pixel of `pixels` that adaptive sampling with
+/// `threshold` has not stopped (see [`is_converged`]); `None` samples every one.
 pub fn add_samples_adaptive(
     film: &mut Film,
+    pixels: PixelRect,
     cancel: &AtomicBool,
     threshold: Option<f64>,
     sample: impl Fn(u32, u32) -> Color + Sync,
 ) -> bool {
     match threshold {
-        Some(threshold) => add_samples_where(film, cancel, |pixel| !is_converged(pixel, threshold), sample),
-        None => add_samples(film, cancel, sample),
+        Some(threshold) => add_samples_where(film, pixels, cancel, |pixel| !is_converged(pixel, threshold), sample),
+        None => add_samples_where(film, pixels, cancel, |_| true, sample),
     }
 }
 
-/// Adds one sample to each pixel for which `active(pixel)` holds, judged on
-/// the pixel's state before this pass. Returns false if cancelled.
+/// Adds one sample to each pixel of `pixels` for which `active(pixel)`
+/// holds, judged on the pixel's state before this pass. Returns false if cancelled.
 pub fn add_samples_where(
     film: &mut Film,
+    pixels: PixelRect,
     cancel: &AtomicBool,
     active: impl Fn(&PixelAccumulator) -> bool + Sync,
     sample: impl Fn(u32, u32) -> Color + Sync,
 ) -> bool {
     let width = film.width as usize;
+    let (columns, rows) = (pixels.x0 as usize..pixels.x1 as usize, pixels.y0 as usize..pixels.y1 as usize);
     let rejected = AtomicU64::new(0);
-    film.pixels.par_chunks_mut(width).enumerate().for_each(|(y, row)| {
+    let film_rows = film.pixels.par_chunks_mut(width).enumerate();
+    film_rows.skip(rows.start).take(rows.len()).for_each(|(y, row)| {
         if cancel.load(Ordering::Relaxed) {
             return;
         }
         let mut row_rejected = 0;
-        for (x, pixel) in row.iter_mut().enumerate() {
+        for (x, pixel) in row[columns.clone()].iter_mut().enumerate() {
             if !active(pixel) {
                 continue;
             }
-            let value = sample(x as u32, y as u32);
+            let value = sample((columns.start + x) as u32, y as u32);
             add_finite(pixel, value, &mut row_rejected);
         }
         if row_rejected > 0 {
@@ -111,7 +120,7 @@ mod tests {
         let cancel = AtomicBool::new(false);
         let threshold = 0.1;
         for pass in 0..200u32 {
-            add_samples_adaptive(&mut film, &cancel, Some(threshold), |x, _| {
+            add_samples_adaptive(&mut film, PixelRect::full(2, 1), &cancel, Some(threshold), |x, _| {
                 if x == 0 {
                     Color::splat(0.5)
                 } else {
@@ -126,6 +135,31 @@ mod tests {
         let stopped = film.pixels[1].count;
         assert_eq!(stopped, 102, "noisy pixel stopped after {stopped} samples");
         assert!(is_converged(&film.pixels[1], threshold));
+    }
+
+    /// A pass over a rectangle samples its pixels, at their own coordinates,
+    /// and leaves every other pixel untouched.
+    #[test]
+    fn a_pass_over_a_rectangle_samples_only_its_pixels() {
+        let mut film = Film::new(5, 4);
+        let cancel = AtomicBool::new(false);
+        let rect = PixelRect {
+            x0: 1,
+            y0: 2,
+            x1: 4,
+            y1: 3,
+        };
+        add_samples_adaptive(&mut film, rect, &cancel, None, |x, y| Color::new(x as f64, y as f64, 1.0));
+        for y in 0..4 {
+            for x in 0..5 {
+                let pixel = &film.pixels[(y * 5 + x) as usize];
+                let inside = rect.contains(x, y);
+                assert_eq!(pixel.count, u32::from(inside), "pixel ({x}, {y})");
+                if inside {
+                    assert_eq!(pixel.mean(), Color::new(x as f64, y as f64, 1.0));
+                }
+            }
+        }
     }
 
     /// A render whose pixels have all converged stops there, not at its

@@ -5,7 +5,12 @@
 //! image, raises an `AtomicBool` cancel flag so the pass in flight stops at
 //! its next row. The thread then drains every pending command, starts a new
 //! *generation* (a fresh integrator: accumulation restarts) and keeps
-//! rendering. After each pass it publishes the frame and its statistics into
+//! rendering. Pause, Stop, Resume and new sample or time targets keep the
+//! generation: they take effect between passes, so nothing rendered is lost,
+//! and a finished render whose target is raised simply continues.
+//!
+//! A region render (`RenderSettings::region`) samples only a rectangle; the
+//! published frames show it over the last image of before (the backdrop). After each pass it publishes the frame and its statistics into
 //! a shared slot (one mutex swap per pass; the pixel loop itself takes no
 //! lock) and calls the `wake` callback. Frames carry the generation they
 //! belong to, so a reader can tell a stale frame from a newer one.
@@ -19,12 +24,12 @@ use crate::camera::Camera;
 use crate::film::Frame;
 use crate::integrator;
 use crate::scene::Scene;
-use crate::settings::RenderSettings;
+use crate::settings::{PixelRect, RenderSettings};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, Sender};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::thread::JoinHandle;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 /// After a restart, one pass is rendered at each of these fractions of the
 /// resolution before accumulation starts at full resolution: 1/8 costs 1/64
@@ -47,10 +52,13 @@ pub enum Command {
     SetScene(Arc<Scene>),
     /// Stop after the current pass and keep the accumulation.
     Pause,
-    /// Continue a paused render, or start again after `Stop` or a finished render.
+    /// Continue a paused or stopped render where it was.
     Resume,
-    /// Abort now; the last published frame stays.
+    /// End the render after the pass in flight, keeping the accumulation
+    /// (`Resume` or a raised target continues it).
     Stop,
+    /// New sample and time targets for the same accumulation: no restart.
+    SetTargets(Option<u32>, Option<Duration>),
     /// Throw the accumulation away and start again with the same inputs.
     Restart,
     /// End the thread.
@@ -62,12 +70,7 @@ impl Command {
     fn aborts_pass(&self) -> bool {
         matches!(
             self,
-            Command::SetSettings(_)
-                | Command::SetCamera(_)
-                | Command::SetScene(_)
-                | Command::Stop
-                | Command::Restart
-                | Command::Quit
+            Command::SetSettings(_) | Command::SetCamera(_) | Command::SetScene(_) | Command::Restart | Command::Quit
         )
     }
 }
@@ -102,6 +105,9 @@ pub struct RenderStats {
     pub samples_per_second: f64,
     /// The integrator's own status line (e.g. the SPPM radius).
     pub integrator_status: String,
+    /// When the pass in flight started (while rendering), so a reader can
+    /// show the render time running between passes.
+    pub pass_started: Option<Instant>,
     pub rejected_samples: u64,
     /// The camera and settings the render thread is using now.
     pub camera: Option<Camera>,
@@ -123,6 +129,23 @@ impl RenderStats {
     pub fn remaining(&self) -> Option<Duration> {
         self.progress().remaining()
     }
+
+    /// Render time as of `now`: the published time plus the pass in flight.
+    pub fn live_elapsed(&self, now: Instant) -> Duration {
+        self.elapsed + self.in_flight(now)
+    }
+
+    /// Estimated time left as of `now`, counting down during the pass in flight.
+    pub fn live_remaining(&self, now: Instant) -> Option<Duration> {
+        self.remaining().map(|r| r.saturating_sub(self.in_flight(now)))
+    }
+
+    fn in_flight(&self, now: Instant) -> Duration {
+        match (self.state, self.pass_started) {
+            (SessionState::Rendering, Some(start)) => now.saturating_duration_since(start),
+            _ => Duration::ZERO,
+        }
+    }
 }
 
 /// A published frame and what it was rendered with.
@@ -143,6 +166,13 @@ pub struct FrameInfo {
     /// SPPM's per-pixel gather radius (row-major, 0 where none yet); `None`
     /// for other integrators.
     pub radii: Option<Arc<Vec<f32>>>,
+    /// Samples per pixel where the integrator reports them (adaptive
+    /// sampling and region renders make them differ between pixels).
+    pub sample_counts: Option<Arc<Vec<u32>>>,
+    /// Whether `frame.noise` is an estimate (see `Integrator::estimates_noise`).
+    pub noise_estimated: bool,
+    /// The rectangle rendered, for a region render.
+    pub region: Option<PixelRect>,
 }
 
 /// What the render thread publishes: the latest frame and the current statistics.
@@ -164,6 +194,8 @@ pub struct RenderSession {
     published: Arc<Mutex<Published>>,
     /// Generation the owner has asked for (the render thread catches up).
     requested_generation: u64,
+    /// The settings last sent, to tell a new target from a restart.
+    sent_settings: Option<RenderSettings>,
     thread: Option<JoinHandle<()>>,
 }
 
@@ -201,6 +233,8 @@ impl RenderSession {
             mode: SessionState::Idle,
             render: None,
             sequence: 0,
+            backdrop: None,
+            last_frame: None,
         };
         let thread = std::thread::Builder::new()
             .name("prism-render".into())
@@ -210,6 +244,7 @@ impl RenderSession {
             cancel,
             published,
             requested_generation: 0,
+            sent_settings: None,
             thread: Some(thread),
         })
     }
@@ -218,7 +253,7 @@ impl RenderSession {
     /// flight. Returns the generation the next frames will carry.
     pub fn send(&mut self, command: Command) -> u64 {
         let aborts = command.aborts_pass();
-        if aborts || matches!(command, Command::Resume) {
+        if aborts {
             self.requested_generation += 1;
         }
         // Send first, then raise the flag: the thread clears the flag before
@@ -229,8 +264,20 @@ impl RenderSession {
         self.requested_generation
     }
 
+    /// New settings: a restart, unless only the sample target or the time
+    /// limit changed, which the accumulation takes on as it is.
     pub fn set_settings(&mut self, settings: RenderSettings) -> u64 {
-        self.send(Command::SetSettings(settings))
+        let only_targets = self.sent_settings.as_ref().is_some_and(|sent| {
+            let mut same = settings.clone();
+            (same.samples_per_pixel, same.time_limit) = (sent.samples_per_pixel, sent.time_limit);
+            same == *sent
+        });
+        self.sent_settings = Some(settings.clone());
+        if only_targets {
+            self.send(Command::SetTargets(settings.samples_per_pixel, settings.time_limit))
+        } else {
+            self.send(Command::SetSettings(settings))
+        }
     }
 
     pub fn set_camera(&mut self, camera: Camera) -> u64 {
@@ -306,6 +353,10 @@ struct Worker {
     /// `None` until the first pass of a generation.
     render: Option<ProgressiveRender>,
     sequence: u64,
+    /// What a region render is shown over: the last frame of before the region.
+    backdrop: Option<Arc<Frame>>,
+    /// The frame last published (after compositing).
+    last_frame: Option<Arc<Frame>>,
 }
 
 /// What a batch of commands asks for.
@@ -348,7 +399,7 @@ impl Worker {
         let mut restart = false;
         for command in batch {
             // The owner counts generations the same way (see `RenderSession::send`).
-            if command.aborts_pass() || matches!(command, Command::Resume) {
+            if command.aborts_pass() {
                 self.generation += 1;
             }
             match command {
@@ -369,14 +420,29 @@ impl Worker {
                         self.mode = SessionState::Paused;
                     }
                 }
-                Command::Resume => match self.mode {
-                    SessionState::Paused => self.mode = SessionState::Rendering,
-                    SessionState::Stopped | SessionState::Finished => restart = true,
-                    SessionState::Idle | SessionState::Rendering => {}
-                },
+                Command::Resume => {
+                    if matches!(self.mode, SessionState::Paused | SessionState::Stopped) {
+                        self.mode = SessionState::Rendering;
+                        self.finish_if_done();
+                    }
+                }
                 Command::Stop => {
-                    self.render = None;
-                    self.mode = SessionState::Stopped;
+                    if matches!(self.mode, SessionState::Rendering | SessionState::Paused) {
+                        self.mode = SessionState::Stopped;
+                    }
+                }
+                Command::SetTargets(passes, time_limit) => {
+                    (self.settings.samples_per_pixel, self.settings.time_limit) = (passes, time_limit);
+                    if let Some(render) = self.render.as_mut() {
+                        render.set_targets(passes, time_limit);
+                    }
+                    match self.mode {
+                        // A finished render whose target was raised continues.
+                        SessionState::Finished => self.mode = SessionState::Rendering,
+                        SessionState::Rendering => {}
+                        _ => continue,
+                    }
+                    self.finish_if_done();
                 }
                 Command::Restart => restart = true,
                 Command::Quit => return Next::Quit,
@@ -384,10 +450,19 @@ impl Worker {
         }
         if restart {
             self.render = None;
+            // A region is shown over the image of before it.
+            self.backdrop = self.settings.region.and(self.last_frame.clone());
             // A change made while paused or stopped is shown at once: it renders.
             self.mode = SessionState::Rendering;
         }
         Next::Continue
+    }
+
+    /// Marks the render finished if its targets are already met.
+    fn finish_if_done(&mut self) {
+        if self.render.as_ref().is_some_and(ProgressiveRender::is_finished) {
+            self.mode = SessionState::Finished;
+        }
     }
 
     fn render_one_pass(&mut self) {
@@ -396,7 +471,13 @@ impl Worker {
         };
         if self.render.is_none() {
             let render = ProgressiveRender::new(&self.settings);
-            for divisor in PREVIEW_DIVISORS {
+            // A region keeps the full image around it; coarse previews would replace it.
+            let divisors = if self.settings.region.is_some() {
+                &[][..]
+            } else {
+                &PREVIEW_DIVISORS[..]
+            };
+            for &divisor in divisors {
                 self.render_preview(render.integrator(), &scene, &camera, divisor);
                 if self.cancel.load(Ordering::Relaxed) {
                     return;
@@ -404,6 +485,7 @@ impl Worker {
             }
             self.render = Some(render);
         }
+        self.publish_pass_start();
         let Some(render) = self.render.as_mut() else { return };
         let cancel = &self.cancel;
         let completed = self.pool.install(|| render.step(&scene, &camera, cancel));
@@ -416,8 +498,8 @@ impl Worker {
             self.mode = SessionState::Finished;
         }
         let integrator = render.integrator();
-        let (frame, radii) = (integrator.frame(), integrator.gather_radii());
-        self.publish(Some(frame), radii, false);
+        let (frame, extras) = (integrator.frame(), Extras::of(integrator));
+        self.publish(Some(frame), extras, false);
     }
 
     /// One pass at 1/`divisor` of the resolution, published as a stand-in
@@ -430,7 +512,7 @@ impl Worker {
         let mut preview = full.preview(divisor);
         let cancel = &self.cancel;
         if self.pool.install(|| preview.render_pass(scene, camera, cancel)) {
-            self.publish(Some(preview.frame()), None, true);
+            self.publish(Some(preview.frame()), Extras::of(preview.as_ref()), true);
         }
     }
 
@@ -449,7 +531,7 @@ impl Worker {
             }
             None => (0, String::new(), 0),
         };
-        let samples = passes as f64 * self.settings.pixel_count() as f64;
+        let samples = passes as f64 * self.settings.sampled_pixels().pixel_count() as f64;
         RenderStats {
             generation: self.generation,
             state: self.mode,
@@ -459,6 +541,7 @@ impl Worker {
             time_limit: self.settings.time_limit,
             samples_per_second: samples / self.elapsed().as_secs_f64().max(1e-9),
             integrator_status: status,
+            pass_started: None,
             rejected_samples: rejected,
             camera: self.camera,
             settings: self.settings.clone(),
@@ -466,7 +549,7 @@ impl Worker {
     }
 
     /// Replaces the published frame (if `frame` is given) and statistics, then wakes the owner.
-    fn publish(&mut self, frame: Option<Frame>, radii: Option<Vec<f32>>, preview: bool) {
+    fn publish(&mut self, frame: Option<Frame>, extras: Extras, preview: bool) {
         let stats = self.stats();
         let info = match (frame, self.camera) {
             (Some(frame), Some(camera)) => {
@@ -474,8 +557,14 @@ impl Worker {
                 let mut settings = self.settings.clone();
                 settings.width = frame.width;
                 settings.height = frame.height;
+                let region = settings.region.map(|r| r.pixels(frame.width, frame.height));
+                let frame = Arc::new(match (region, &self.backdrop) {
+                    (Some(region), Some(backdrop)) => composite(backdrop, frame, region),
+                    _ => frame,
+                });
+                self.last_frame = Some(Arc::clone(&frame));
                 Some(FrameInfo {
-                    frame: Arc::new(frame),
+                    frame,
                     generation: self.generation,
                     sequence: self.sequence,
                     camera,
@@ -483,7 +572,10 @@ impl Worker {
                     passes: if preview { 0 } else { stats.passes },
                     elapsed: self.elapsed(),
                     preview,
-                    radii: radii.map(Arc::new),
+                    radii: extras.radii.map(Arc::new),
+                    sample_counts: extras.sample_counts.map(Arc::new),
+                    noise_estimated: extras.noise_estimated,
+                    region,
                 })
             }
             _ => None,
@@ -499,8 +591,56 @@ impl Worker {
     }
 
     fn publish_stats(&mut self) {
-        self.publish(None, None, false);
+        self.publish(None, Extras::default(), false);
     }
+
+    /// Marks the start of a pass in the published statistics (no wake-up:
+    /// the owner reads it with its next frame).
+    fn publish_pass_start(&mut self) {
+        let mut stats = self.stats();
+        stats.pass_started = Some(Instant::now());
+        lock(&self.published).stats = stats;
+    }
+}
+
+/// What a frame is published with besides its pixels.
+#[derive(Default)]
+struct Extras {
+    radii: Option<Vec<f32>>,
+    sample_counts: Option<Vec<u32>>,
+    noise_estimated: bool,
+}
+
+impl Extras {
+    fn of(integrator: &dyn integrator::Integrator) -> Self {
+        Self {
+            radii: integrator.gather_radii(),
+            sample_counts: integrator.sample_counts(),
+            noise_estimated: integrator.estimates_noise(),
+        }
+    }
+}
+
+/// `frame`'s pixels inside `region` over a copy of `backdrop` (when the two
+/// have the same size; otherwise the frame as it is).
+fn composite(backdrop: &Frame, frame: Frame, region: PixelRect) -> Frame {
+    if (backdrop.width, backdrop.height) != (frame.width, frame.height) {
+        return frame;
+    }
+    let mut out = backdrop.clone();
+    if out.noise.len() != out.pixels.len() {
+        out.noise = vec![f32::INFINITY; out.pixels.len()];
+    }
+    let width = frame.width as usize;
+    for y in region.y0 as usize..region.y1 as usize {
+        let row = y * width + region.x0 as usize..y * width + region.x1 as usize;
+        out.pixels[row.clone()].copy_from_slice(&frame.pixels[row.clone()]);
+        match frame.noise.get(row.clone()) {
+            Some(noise) => out.noise[row].copy_from_slice(noise),
+            None => out.noise[row].fill(f32::INFINITY),
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -508,7 +648,6 @@ mod tests {
     use super::*;
     use crate::scene::{DEFAULT_SCENE, load_scene_str};
     use std::path::Path;
-    use std::time::Instant;
 
     fn session_on_default_scene(samples: Option<u32>) -> (RenderSession, Camera) {
         let loaded = load_scene_str(DEFAULT_SCENE, Path::new("cornell"), Path::new(".")).expect("default scene");
@@ -570,5 +709,74 @@ mod tests {
         });
         session.send(Command::Stop);
         wait_for(&session, "the stop", |p| p.stats.state == SessionState::Stopped);
+    }
+
+    #[test]
+    fn stop_keeps_the_samples_and_resume_continues_them() {
+        let (mut session, _) = session_on_default_scene(None);
+        wait_for(&session, "two passes", |p| p.stats.passes >= 2);
+        session.send(Command::Stop);
+        let stopped = wait_for(&session, "the stop", |p| p.stats.state == SessionState::Stopped);
+        assert!(stopped.stats.passes >= 2, "the samples are kept: {:?}", stopped.stats);
+        let frame = stopped.frame.expect("a frame");
+        assert_eq!(frame.passes, stopped.stats.passes, "the image shown holds them");
+        session.send(Command::Resume);
+        let resumed = wait_for(&session, "more passes", |p| p.stats.passes > stopped.stats.passes);
+        assert_eq!(resumed.stats.generation, stopped.stats.generation, "the same accumulation");
+    }
+
+    #[test]
+    fn a_raised_target_continues_a_finished_render() {
+        let loaded = load_scene_str(DEFAULT_SCENE, Path::new("cornell"), Path::new(".")).expect("default scene");
+        let mut settings = loaded.settings.clone();
+        (settings.width, settings.height, settings.samples_per_pixel) = (16, 16, Some(2));
+        let mut session = RenderSession::new(settings.clone(), 1, 0, Box::new(|| {})).expect("session");
+        session.set_settings(settings.clone());
+        session.set_camera(loaded.camera);
+        let generation = session.set_scene(Arc::new(loaded.scene));
+        wait_for(&session, "the first target", |p| p.stats.state == SessionState::Finished);
+        settings.samples_per_pixel = Some(4);
+        assert_eq!(session.set_settings(settings), generation, "a new target is no restart");
+        let more = wait_for(&session, "the raised target", |p| {
+            p.stats.state == SessionState::Finished && p.stats.passes == 4
+        });
+        assert_eq!(more.stats.generation, generation);
+        assert_eq!(more.frame.expect("a frame").passes, 4);
+    }
+
+    #[test]
+    fn a_region_render_keeps_the_image_around_it() {
+        let (mut session, _) = session_on_default_scene(Some(2));
+        let full = wait_for(&session, "the full image", |p| p.stats.state == SessionState::Finished);
+        let full_frame = full.frame.expect("a frame").frame;
+        let mut settings = full.stats.settings.clone();
+        settings.region = crate::settings::Region::from_corners([0.25, 0.25], [0.5, 0.75]);
+        let generation = session.set_settings(settings);
+        let region = wait_for(&session, "the region", |p| {
+            p.stats.generation == generation && p.stats.state == SessionState::Finished
+        });
+        let info = region.frame.expect("a frame");
+        let rect = info.region.expect("a region frame");
+        assert_eq!(
+            rect,
+            PixelRect {
+                x0: 6,
+                y0: 6,
+                x1: 12,
+                y1: 18
+            }
+        );
+        let counts = info.sample_counts.expect("path tracing counts samples");
+        for y in 0..24 {
+            for x in 0..24 {
+                let i = (y * 24 + x) as usize;
+                if rect.contains(x, y) {
+                    assert_eq!(counts[i], 2, "({x}, {y}) rendered");
+                } else {
+                    assert_eq!(counts[i], 0, "({x}, {y}) not rendered");
+                    assert_eq!(info.frame.pixels[i], full_frame.pixels[i], "({x}, {y}) kept");
+                }
+            }
+        }
     }
 }

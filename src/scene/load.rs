@@ -8,6 +8,7 @@
 use super::description::*;
 use super::document::{Document, FieldPath};
 use super::error::{Location, SceneError};
+use super::progress::LoadStage;
 use super::{Primitive, Scene};
 use crate::camera::Camera;
 use crate::color::Color;
@@ -50,11 +51,17 @@ pub struct LoadedScene {
 
 /// Reads and builds a scene file; relative paths inside resolve against its folder.
 pub fn load_scene_file(path: &Path) -> Result<LoadedScene, SceneError> {
+    load_scene_file_reporting(path, &|_| {})
+}
+
+/// `load_scene_file`, telling `progress` which stage it is in (see `scene::progress`).
+pub(super) fn load_scene_file_reporting(path: &Path, progress: &dyn Fn(LoadStage)) -> Result<LoadedScene, SceneError> {
+    progress(LoadStage::Parsing);
     let cannot_read = |message: String| SceneError::new(path, None, None, message);
     crate::geometry::mesh::regular_file(path).map_err(&cannot_read)?;
     let bytes = std::fs::read(path).map_err(|e| cannot_read(format!("cannot read scene file: {e}")))?;
     let base = path.parent().unwrap_or(Path::new("."));
-    let mut loaded = load_scene_bytes(&bytes, path, base)?;
+    let mut loaded = load_scene_bytes_reporting(&bytes, path, base, progress)?;
     loaded.path = Some(path.to_path_buf());
     Ok(loaded)
 }
@@ -62,6 +69,15 @@ pub fn load_scene_file(path: &Path) -> Result<LoadedScene, SceneError> {
 /// Builds a scene from the bytes of a scene file, which must be UTF-8 (an
 /// error names the line and column of the first bad byte).
 pub fn load_scene_bytes(bytes: &[u8], file: &Path, base: &Path) -> Result<LoadedScene, SceneError> {
+    load_scene_bytes_reporting(bytes, file, base, &|_| {})
+}
+
+fn load_scene_bytes_reporting(
+    bytes: &[u8],
+    file: &Path,
+    base: &Path,
+    progress: &dyn Fn(LoadStage),
+) -> Result<LoadedScene, SceneError> {
     let text = std::str::from_utf8(bytes).map_err(|e| {
         // Everything before the first bad byte is valid text to count in.
         let valid = std::str::from_utf8(&bytes[..e.valid_up_to()]).unwrap_or_default();
@@ -72,7 +88,7 @@ pub fn load_scene_bytes(bytes: &[u8], file: &Path, base: &Path) -> Result<Loaded
             format!("the file is not valid UTF-8 (byte 0x{:02x})", bytes[e.valid_up_to()]),
         )
     })?;
-    load_scene_str(text, file, base)
+    load_scene_str_edited_reporting(text, file, base, |_| {}, progress)
 }
 
 /// Builds a scene from TOML text; `file` names it in errors, `base` resolves paths.
@@ -88,6 +104,16 @@ pub fn load_scene_str_edited(
     base: &Path,
     edit: impl FnOnce(&mut SceneDescription),
 ) -> Result<LoadedScene, SceneError> {
+    load_scene_str_edited_reporting(text, file, base, edit, &|_| {})
+}
+
+fn load_scene_str_edited_reporting(
+    text: &str,
+    file: &Path,
+    base: &Path,
+    edit: impl FnOnce(&mut SceneDescription),
+    progress: &dyn Fn(LoadStage),
+) -> Result<LoadedScene, SceneError> {
     let document = Document::parse(text, file)?;
     let retagged = document.retagged(&["objects"], &["materials"])?;
     let mut description: SceneDescription = document.deserialize(retagged)?;
@@ -96,6 +122,7 @@ pub fn load_scene_str_edited(
         document: &document,
         base,
         warnings: RefCell::default(),
+        progress,
     };
     builder.build(description)
 }
@@ -104,6 +131,7 @@ struct Builder<'a> {
     document: &'a Document<'a>,
     base: &'a Path,
     warnings: RefCell<Vec<String>>,
+    progress: &'a dyn Fn(LoadStage),
 }
 
 impl Builder<'_> {
@@ -166,6 +194,10 @@ impl Builder<'_> {
         let mut primitives = Vec::new();
         let mut meshes = Vec::new();
         for (i, object) in description.objects.iter().enumerate() {
+            (self.progress)(LoadStage::Objects {
+                done: i,
+                total: description.objects.len(),
+            });
             let path = root.key("objects").index(i);
             let material = match object.material() {
                 None => None,
@@ -190,6 +222,9 @@ impl Builder<'_> {
             Some(b) => self.color(&root.key("background"), b)?,
             None => Color::ZERO,
         };
+        (self.progress)(LoadStage::Bvh {
+            primitives: primitives.len(),
+        });
         let scene = Scene::new(primitives, meshes, materials, background);
         Ok(LoadedScene {
             scene,

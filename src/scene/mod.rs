@@ -9,10 +9,12 @@ pub mod description;
 pub mod document;
 pub mod error;
 pub mod load;
+pub mod progress;
 pub mod similarity;
 
 pub use error::{Location, SceneError};
 pub use load::{COORDINATE_LIMIT, LoadedScene, load_scene_bytes, load_scene_file, load_scene_str, load_scene_str_edited};
+pub use progress::{LoadStage, load_scene_file_with_progress};
 pub use similarity::{Similarity, load_scene_str_placed};
 
 use crate::accel::{BuildPrimitive, Bvh, TraversalRay};

@@ -3,17 +3,18 @@
 //! thread whatever the user changed. Rendering itself never happens here.
 
 use super::camera_input::DepthGrid;
+use super::denoiser::Denoiser;
+use super::display::{CompareMode, DenoiseMode, Display, Reference};
 use super::event_log::EventLog;
-use super::files::{Dialog, DialogPurpose, SaveState};
+use super::files::{Dialog, DialogPurpose, OpenState, SaveState};
+use super::image_view::{ImageZoom, RegionDrag};
 use super::loader::{DEFAULT_SCENE_NAME, FileWatch, LoadResult, SceneLoader};
-use super::texture;
-use super::{ViewerStart, panels};
+use super::{ViewerStart, panels, status};
 use crate::camera::Camera;
 use crate::film::ToneMap;
 use crate::render::RenderSettings;
 use crate::render::session::{Command, FrameInfo, RenderSession, RenderStats, SessionError};
 use crate::scene::Scene;
-use egui::{TextureHandle, TextureOptions};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -33,16 +34,9 @@ pub enum ViewKind {
     Radii,
 }
 
-/// What the image area currently shows.
-#[derive(Default)]
-pub(super) struct Display {
-    pub texture: Option<TextureHandle>,
-    pub frame: Option<FrameInfo>,
-    pub stats: RenderStats,
-    /// (frame sequence, exposure, tone map, view) the texture was made for.
-    mapped_for: Option<(u64, f64, ToneMap, ViewKind)>,
-    pub noise: Option<f64>,
-}
+/// Width of the side panel: fixed, so that opening a section or a longer
+/// label never moves the image.
+const SIDE_PANEL_WIDTH: f32 = 320.0;
 
 /// The viewer application. `show` draws one frame into a `Ui`; eframe calls
 /// it through `App::ui`, and tests drive it with egui_kittest.
@@ -76,6 +70,26 @@ pub struct ViewerApp {
     pub(super) dialog: Option<Dialog>,
     pub(super) log: EventLog,
     continuous_repaint: bool,
+    /// The scene path field, recent files and the shipped scenes.
+    pub(super) open: OpenState,
+    /// Why the last typed value was refused (shown under the controls).
+    pub(super) input_error: Option<String>,
+    pub(super) denoiser: Option<Denoiser>,
+    pub(super) denoise_mode: DenoiseMode,
+    /// Display-only cap on pixel luminance (biased), if on.
+    pub(super) firefly_clamp: Option<f32>,
+    pub(super) compare_mode: CompareMode,
+    pub(super) reference: Option<Reference>,
+    pub(super) reference_path_text: String,
+    pub(super) show_histogram: bool,
+    pub(super) zoom: ImageZoom,
+    /// Drawing a region: drag on the image instead of orbiting.
+    pub(super) region_tool: bool,
+    pub(super) region_drag: Option<RegionDrag>,
+    /// Image pixel under the cursor.
+    pub(super) hovered_pixel: Option<(u32, u32)>,
+    /// Where the image (its left copy, side by side) was last drawn.
+    pub(super) image_rect: Option<egui::Rect>,
 }
 
 impl ViewerApp {
@@ -90,7 +104,10 @@ impl ViewerApp {
         )?;
         let repaint = ctx.clone();
         let mut loader = SceneLoader::new(Arc::new(move || repaint.request_repaint()));
+        let repaint = ctx.clone();
+        let denoiser = Denoiser::new(Arc::new(move || repaint.request_repaint())).ok();
         let log = EventLog::new(start.log, launched);
+        let open = OpenState::new(start.recent_file.clone(), start.scene.as_deref());
         let mut app = Self {
             session,
             loader: SceneLoader::new(Arc::new(|| {})),
@@ -114,12 +131,27 @@ impl ViewerApp {
             display: Display::default(),
             save: SaveState {
                 path_text: "prism-snapshot.png".into(),
+                denoised: false,
                 message: None,
                 dialog_unavailable: false,
             },
             dialog: None,
             log,
             continuous_repaint: start.continuous_repaint,
+            open,
+            input_error: None,
+            denoiser,
+            denoise_mode: DenoiseMode::Off,
+            firefly_clamp: None,
+            compare_mode: CompareMode::Off,
+            reference: None,
+            reference_path_text: String::new(),
+            show_histogram: true,
+            zoom: ImageZoom::default(),
+            region_tool: false,
+            region_drag: None,
+            hovered_pixel: None,
+            image_rect: None,
         };
         if let Err(error) = loader.load(start.scene) {
             app.scene_error = Some(format!("cannot start the scene loader: {error}"));
@@ -156,6 +188,26 @@ impl ViewerApp {
         self.session.latest().stats
     }
 
+    /// The sampling settings as the user set them (at the scene's own resolution).
+    pub fn settings(&self) -> &RenderSettings {
+        &self.settings
+    }
+
+    /// Image pixels per screen point, or `None` while the image is fitted to the window.
+    pub fn image_zoom(&self) -> Option<f32> {
+        self.zoom.scale
+    }
+
+    /// Where the image was last drawn on screen (its raw copy, side by side).
+    pub fn image_rect(&self) -> Option<egui::Rect> {
+        self.image_rect
+    }
+
+    /// Whether a denoised frame has arrived for the preview.
+    pub fn has_denoised_frame(&self) -> bool {
+        self.display.denoised.is_some()
+    }
+
     /// The frame on screen.
     pub fn displayed_frame(&self) -> Option<&FrameInfo> {
         self.display.frame.as_ref()
@@ -166,12 +218,22 @@ impl ViewerApp {
         self.loader.busy()
     }
 
+    /// The running load's stage and time so far.
+    pub(super) fn loader_stage(&self) -> Option<(crate::scene::LoadStage, Duration)> {
+        self.loader.stage()
+    }
+
     /// Draws one frame of the whole window into `ui`.
     pub fn show(&mut self, ui: &mut egui::Ui) {
+        self.show_timed(ui, None);
+    }
+
+    /// `show`, told how long eframe's previous whole frame took (for the log).
+    fn show_timed(&mut self, ui: &mut egui::Ui, previous_frame: Option<Duration>) {
         let began = Instant::now();
         let ctx = ui.ctx().clone();
         self.take_scene_load();
-        self.take_published(&ctx);
+        self.refresh_display(&ctx);
         self.handle_input(&ctx);
         self.poll_dialog();
         if self.auto_reload && !self.loader.busy() && self.watch.changed(Instant::now()) {
@@ -181,20 +243,30 @@ impl ViewerApp {
 
         self.interacting = false;
         self.show_focal_plane = false;
-        egui::Panel::left("controls").default_size(290.0).show(ui, |ui| {
-            egui::ScrollArea::vertical().show(ui, |ui| panels::ui_controls(self, ui));
-        });
-        egui::Panel::bottom("status").show(ui, |ui| panels::ui_status(self, ui));
-        egui::CentralPanel::default().show(ui, |ui| self.ui_image(ui));
+        egui::Panel::left("controls")
+            .exact_size(SIDE_PANEL_WIDTH)
+            .resizable(false)
+            .show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| panels::ui_controls(self, ui));
+            });
+        egui::Panel::bottom("status").show(ui, |ui| status::ui_status(self, ui));
+        // No fill: the image covers what it needs, and software GL then paints
+        // the window's largest area once instead of twice.
+        egui::CentralPanel::default()
+            .frame(egui::Frame::NONE)
+            .show(ui, |ui| self.ui_image(ui));
 
         self.sync_session();
         let stats = self.display.stats.clone();
-        self.log.frame_tick(&stats, began.elapsed());
+        self.log.frame_tick(&stats, began.elapsed(), previous_frame);
         if self.continuous_repaint {
             // The logged frame rate is then what the UI can sustain.
             ctx.request_repaint();
         } else if self.dialog.is_some() || self.loader.busy() {
             ctx.request_repaint_after(Duration::from_millis(100));
+        } else if self.display.stats.state == crate::render::session::SessionState::Rendering {
+            // The render time and estimate in the status line run between passes.
+            ctx.request_repaint_after(Duration::from_millis(250));
         } else if self.auto_reload && self.watch.path.is_some() {
             ctx.request_repaint_after(super::loader::WATCH_INTERVAL);
         }
@@ -223,6 +295,10 @@ impl ViewerApp {
         self.scene_path = path;
         match outcome {
             Ok(ready) => {
+                if let Some(path) = &self.scene_path {
+                    self.open.remember(path);
+                }
+                self.zoom = ImageZoom::default();
                 self.log.event(&format!(
                     "scene {} loaded in {:.1} ms",
                     self.scene_name(),
@@ -243,44 +319,7 @@ impl ViewerApp {
         }
     }
 
-    /// Uploads the newest published frame, or re-maps the current one after a display-only change.
-    fn take_published(&mut self, ctx: &egui::Context) {
-        let published = self.session.latest();
-        self.display.stats = published.stats;
-        if let Some(info) = published.frame {
-            let newer = match &self.display.frame {
-                Some(shown) => info.sequence != shown.sequence && info.generation >= shown.generation,
-                None => true,
-            };
-            if newer {
-                self.display.noise = texture::noise_estimate(&info.frame);
-                self.log_refresh(&info);
-                self.display.frame = Some(info);
-            }
-        }
-        let Some(info) = &self.display.frame else {
-            return;
-        };
-        let key = (info.sequence, self.exposure, self.tone_map, self.view);
-        if self.display.mapped_for == Some(key) {
-            return;
-        }
-        let image = match self.view {
-            ViewKind::Image => texture::tone_mapped(&info.frame, self.exposure, self.tone_map),
-            ViewKind::Radii if info.radii.as_ref().is_some_and(|r| r.len() == info.frame.pixels.len()) => {
-                let radii = info.radii.as_deref().map_or(&[][..], Vec::as_slice);
-                texture::radii_heatmap(info.frame.width, info.frame.height, radii)
-            }
-            ViewKind::Noise | ViewKind::Radii => texture::noise_heatmap(&info.frame),
-        };
-        match &mut self.display.texture {
-            Some(texture) => texture.set(image, TextureOptions::LINEAR),
-            None => self.display.texture = Some(ctx.load_texture("prism-render", image, TextureOptions::LINEAR)),
-        }
-        self.display.mapped_for = Some(key);
-    }
-
-    fn log_refresh(&mut self, info: &FrameInfo) {
+    pub(super) fn log_refresh(&mut self, info: &FrameInfo) {
         if !self.log.enabled {
             return;
         }
@@ -391,8 +430,9 @@ impl ViewerApp {
 }
 
 impl eframe::App for ViewerApp {
-    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
-        self.show(ui);
+    fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
+        let previous = frame.info().cpu_usage.map(|s| Duration::from_secs_f32(s.max(0.0)));
+        self.show_timed(ui, previous);
     }
 }
 

@@ -18,6 +18,32 @@ pub(super) struct EventLog {
     last_frame: Option<Instant>,
     /// Time spent in `ViewerApp::show` (layout and uploads, not painting) this second.
     busy: Duration,
+    /// eframe's whole-frame time (layout, tessellation, GL painting, buffer swap) this second.
+    frame_work: Duration,
+    /// The UI thread's scheduler counters at the window's start (see [`SchedulerTimes`]).
+    scheduler: Option<SchedulerTimes>,
+}
+
+/// The calling thread's time on a CPU and time spent runnable but waiting for
+/// one (Linux `/proc/thread-self/schedstat`): a UI thread that waits long for
+/// a CPU is starved by other threads, not slow itself.
+#[derive(Clone, Copy, Debug)]
+struct SchedulerTimes {
+    running: Duration,
+    waiting: Duration,
+}
+
+impl SchedulerTimes {
+    fn now() -> Option<Self> {
+        let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+        let mut fields = text.split_whitespace().map(|f| f.parse::<u64>().ok());
+        let running = fields.next()??;
+        let waiting = fields.next()??;
+        Some(Self {
+            running: Duration::from_nanos(running),
+            waiting: Duration::from_nanos(waiting),
+        })
+    }
 }
 
 impl EventLog {
@@ -32,7 +58,14 @@ impl EventLog {
             worst_frame: Duration::ZERO,
             last_frame: None,
             busy: Duration::ZERO,
+            frame_work: Duration::ZERO,
+            scheduler: None,
         }
+    }
+
+    /// Notes a denoised preview and how long its filter took.
+    pub fn denoise(&self, took: Duration) {
+        self.event(&format!("denoised preview in {:.1} ms", took.as_secs_f64() * 1e3));
     }
 
     pub fn event(&self, what: &str) {
@@ -41,12 +74,18 @@ impl EventLog {
         }
     }
 
-    /// Counts UI frames and prints the rate and the longest gap once a second.
-    pub fn frame_tick(&mut self, stats: &RenderStats, busy: Duration) {
+    /// Counts UI frames and prints the rate and the longest gap once a second,
+    /// with where the time went: `busy` is this frame's layout and upload,
+    /// `frame_work` eframe's measure of the previous whole frame (if known).
+    pub fn frame_tick(&mut self, stats: &RenderStats, busy: Duration, frame_work: Option<Duration>) {
         if !self.enabled {
             return;
         }
         self.busy += busy;
+        self.frame_work += frame_work.unwrap_or_default();
+        if self.scheduler.is_none() {
+            self.scheduler = SchedulerTimes::now();
+        }
         let now = Instant::now();
         if let Some(last) = self.last_frame {
             self.worst_frame = self.worst_frame.max(now - last);
@@ -55,15 +94,28 @@ impl EventLog {
         self.frames += 1;
         let window = now - self.window_start;
         if window >= Duration::from_secs(1) {
+            let per_frame = |d: Duration| d.as_secs_f64() * 1e3 / self.frames.max(1) as f64;
+            let scheduler = match (self.scheduler, SchedulerTimes::now()) {
+                (Some(start), Some(end)) => format!(
+                    ", ui thread on a CPU {:.0} ms and waiting for one {:.0} ms of {:.0} ms",
+                    (end.running.saturating_sub(start.running)).as_secs_f64() * 1e3,
+                    (end.waiting.saturating_sub(start.waiting)).as_secs_f64() * 1e3,
+                    window.as_secs_f64() * 1e3
+                ),
+                _ => String::new(),
+            };
             self.event(&format!(
-                "ui {:.1} frames/s, longest frame gap {:.1} ms, {:.2} ms/frame in layout+upload, render {:?} pass {} at {:.2} Msamples/s",
+                "ui {:.1} frames/s, longest frame gap {:.1} ms, {:.2} ms/frame in layout+upload, {:.2} ms/frame whole frame (paint+swap){scheduler}, render {:?} pass {} at {:.2} Msamples/s",
                 self.frames as f64 / window.as_secs_f64(),
                 self.worst_frame.as_secs_f64() * 1e3,
-                self.busy.as_secs_f64() * 1e3 / self.frames.max(1) as f64,
+                per_frame(self.busy),
+                per_frame(self.frame_work),
                 stats.state,
                 stats.passes,
                 stats.samples_per_second / 1e6
             ));
+            self.frame_work = Duration::ZERO;
+            self.scheduler = SchedulerTimes::now();
             self.frames = 0;
             self.window_start = now;
             self.worst_frame = Duration::ZERO;

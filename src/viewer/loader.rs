@@ -1,14 +1,15 @@
 //! Scene loading off the UI thread, and the on-disk change check that
 //! drives automatic reload. Each load runs on its own named thread and
 //! reports through a channel; results carry a request number so a slow,
-//! older load never replaces a newer one.
+//! older load never replaces a newer one. While it runs, the stage it is in
+//! (parsing, objects and meshes, BVH) is shared for the status line.
 
 use crate::camera::Camera;
 use crate::render::RenderSettings;
-use crate::scene::{self, Scene};
+use crate::scene::{self, LoadStage, Scene};
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::sync::mpsc::{self, Receiver, Sender};
+use std::sync::{Arc, Mutex, PoisonError};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant, SystemTime};
 
@@ -45,6 +46,8 @@ pub struct SceneLoader {
     next_request: u64,
     /// Newest request whose result has been handed out.
     applied_request: u64,
+    /// The newest load's stage and when the load started.
+    stage: Arc<Mutex<Option<(LoadStage, Instant)>>>,
 }
 
 impl SceneLoader {
@@ -57,6 +60,7 @@ impl SceneLoader {
             threads: Vec::new(),
             next_request: 0,
             applied_request: 0,
+            stage: Arc::new(Mutex::new(None)),
         }
     }
 
@@ -66,12 +70,17 @@ impl SceneLoader {
         let request = self.next_request;
         let sender = self.sender.clone();
         let wake = Arc::clone(&self.wake);
+        let stage = Arc::clone(&self.stage);
         self.threads.retain(|thread| !thread.is_finished());
         let thread = std::thread::Builder::new().name("prism-scene-loader".into()).spawn(move || {
             let start = Instant::now();
             let modified = path.as_deref().and_then(modified_time);
+            let report = |now: LoadStage| {
+                *stage.lock().unwrap_or_else(PoisonError::into_inner) = Some((now, start));
+                wake();
+            };
             let loaded = match &path {
-                Some(path) => scene::load_scene_file(path),
+                Some(path) => scene::load_scene_file_with_progress(path, &report),
                 None => scene::load_scene_str(scene::DEFAULT_SCENE, Path::new(DEFAULT_SCENE_NAME), Path::new(".")),
             };
             let outcome = loaded
@@ -97,6 +106,15 @@ impl SceneLoader {
     /// Whether a requested load has not reported yet.
     pub fn busy(&self) -> bool {
         self.applied_request < self.next_request
+    }
+
+    /// While busy: the stage of the newest load and how long it has run.
+    pub fn stage(&self) -> Option<(LoadStage, Duration)> {
+        if !self.busy() {
+            return None;
+        }
+        let stage = *self.stage.lock().unwrap_or_else(PoisonError::into_inner);
+        stage.map(|(stage, start)| (stage, start.elapsed()))
     }
 
     /// The newest finished load, if one arrived; superseded ones are dropped.

@@ -4,21 +4,29 @@
 //! frame as a texture and lays out the panels, so it never waits on rendering.
 //!
 //! Every control is classified once (see `docs/viewer.md`): display-only
-//! (exposure, tone map, view) re-maps the current frame; sampling (camera,
-//! integrator, depth, targets, resolution) restarts accumulation and keeps the
-//! `Arc<Scene>`; scene (open, drop, file changed) loads on a background thread,
-//! then restarts.
+//! (exposure, tone map, view, zoom and pan, pixel readout, histogram, A/B
+//! comparison, the denoised preview) re-maps the current frame; targets
+//! (samples, time) and Pause/Stop/Resume keep the accumulation; sampling
+//! (camera, integrator, depth, resolution, region) restarts accumulation and
+//! keeps the `Arc<Scene>`; scene (open, drop, file changed) loads on a
+//! background thread, then restarts.
 
 mod app;
 mod camera_input;
+mod denoiser;
+mod display;
 mod event_log;
 mod files;
 mod image_view;
+mod inputs;
+mod inspect;
 mod loader;
 mod panels;
+mod status;
 mod texture;
 
 pub use app::{ViewKind, ViewerApp};
+pub use display::{CompareMode, DenoiseMode};
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -40,6 +48,8 @@ pub struct ViewerStart {
     /// Repaint continuously, so the logged frame rate is what the UI can
     /// sustain while rendering: `PRISM_VIEWER_LOG=2`.
     pub continuous_repaint: bool,
+    /// Where the list of recently opened scenes is kept (`None`: this session only).
+    pub recent_file: Option<PathBuf>,
 }
 
 impl Default for ViewerStart {
@@ -55,6 +65,7 @@ impl Default for ViewerStart {
             resolution_scale: 1.0,
             log: log_level >= 1,
             continuous_repaint: log_level >= 2,
+            recent_file: files::default_recent_file(),
         }
     }
 }

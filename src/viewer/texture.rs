@@ -1,12 +1,15 @@
 //! Turning a linear `Frame` into what the window shows: the tone-mapped
 //! image (exposure and tone map are applied here, so they never restart the
-//! render, as in Nori) or a heatmap of the per-pixel noise; and the
-//! image-wide noise estimate for the status line.
+//! render, as in Nori), whole or a band of rows (a region render uploads
+//! only the rows it changed), or a heatmap of the per-pixel noise, the SPPM
+//! radii or the difference from a reference; and the image-wide noise
+//! estimate for the status line.
 
 use crate::color::{luminance, srgb_encode};
 use crate::film::{Frame, ToneMap};
 use egui::{Color32, ColorImage};
 use glam::DVec3;
+use std::ops::Range;
 use std::sync::OnceLock;
 
 /// Entries of the sRGB encoding table over [0, 1]: the curve's steepest part
@@ -32,17 +35,42 @@ fn encode(table: &[u8], value: f64) -> u8 {
 
 /// The frame after exposure (in stops) and tone mapping, sRGB-encoded.
 pub fn tone_mapped(frame: &Frame, exposure_stops: f64, tone_map: ToneMap) -> ColorImage {
+    tone_mapped_rows(frame, exposure_stops, tone_map, 0..frame.height as usize)
+}
+
+/// Rows `rows` of the tone-mapped frame, as an image of their own.
+pub fn tone_mapped_rows(frame: &Frame, exposure_stops: f64, tone_map: ToneMap, rows: Range<usize>) -> ColorImage {
     let table = srgb_table();
     let scale = exposure_stops.exp2();
-    let pixels = frame
-        .pixels
+    let width = frame.width as usize;
+    let pixels = frame.pixels[rows.start * width..rows.end * width]
         .iter()
         .map(|p| {
             let [r, g, b] = p.map(|c| encode(table, tone_map.apply(c as f64 * scale)));
             Color32::from_rgb(r, g, b)
         })
         .collect();
-    ColorImage::new([frame.width as usize, frame.height as usize], pixels)
+    ColorImage::new([width, rows.len()], pixels)
+}
+
+/// Per pixel, how far `frame` is from `reference` relative to the
+/// reference (|Δluminance| / (luminance + 0.01)), on the noise view's log
+/// scale: dark blue 0.1 %, white 100 % or more. `None` if the sizes differ.
+pub fn difference_heatmap(frame: &Frame, reference: &Frame) -> Option<ColorImage> {
+    if (frame.width, frame.height) != (reference.width, reference.height) || frame.pixels.len() != reference.pixels.len() {
+        return None;
+    }
+    let lum = |p: &[f32; 3]| luminance(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
+    let pixels = frame
+        .pixels
+        .iter()
+        .zip(&reference.pixels)
+        .map(|(a, b)| {
+            let relative = (lum(a) - lum(b)).abs() / (lum(b) + 0.01);
+            heat_color(((relative.max(1e-3).log10() + 3.0) / 3.0).clamp(0.0, 1.0))
+        })
+        .collect();
+    Some(ColorImage::new([frame.width as usize, frame.height as usize], pixels))
 }
 
 /// Relative standard error of a pixel's mean (standard error / mean luminance).
@@ -77,21 +105,33 @@ pub fn noise_heatmap(frame: &Frame) -> ColorImage {
     ColorImage::new([frame.width as usize, frame.height as usize], pixels)
 }
 
+/// The smallest and largest positive gather radius, if any.
+pub fn radii_range(radii: &[f32]) -> Option<(f32, f32)> {
+    let positive = radii.iter().copied().filter(|r| *r > 0.0 && r.is_finite());
+    positive.fold(None, |range, r| match range {
+        None => Some((r, r)),
+        Some((lo, hi)) => Some((lo.min(r), hi.max(r))),
+    })
+}
+
 /// A heatmap of SPPM's per-pixel gather radii on a log scale from the
 /// smallest (dark) to the largest (white) current radius; pixels without a
-/// radius yet are black.
+/// radius yet are black. When every radius is the same (an absolute initial
+/// radius at the first iteration) they all show the ramp's middle colour,
+/// and the legend says so.
 pub fn radii_heatmap(width: u32, height: u32, radii: &[f32]) -> ColorImage {
-    let positive = radii.iter().copied().filter(|r| *r > 0.0 && r.is_finite());
-    let (low, high) = positive.fold((f32::INFINITY, 0.0f32), |(lo, hi), r| (lo.min(r), hi.max(r)));
-    let (low, high) = ((low as f64).ln(), (high as f64).ln());
-    let span = (high - low).max(1e-9);
+    let (low, high) = radii_range(radii).map_or((1.0, 1.0), |(lo, hi)| ((lo as f64).ln(), (hi as f64).ln()));
+    // Below a relative spread of 1e-6 the radii are equal up to rounding.
+    let equal = high - low < 1e-6;
     let pixels = radii
         .iter()
         .map(|&r| {
-            if r > 0.0 && r.is_finite() {
-                heat_color(0.1 + 0.9 * ((r as f64).ln() - low) / span)
-            } else {
+            if !(r > 0.0 && r.is_finite()) {
                 Color32::BLACK
+            } else if equal {
+                heat_color(0.5)
+            } else {
+                heat_color(0.1 + 0.9 * ((r as f64).ln() - low) / (high - low))
             }
         })
         .collect();
@@ -99,7 +139,7 @@ pub fn radii_heatmap(width: u32, height: u32, radii: &[f32]) -> ColorImage {
 }
 
 /// A perceptually ordered ramp: black → blue → red → yellow → white.
-fn heat_color(t: f64) -> Color32 {
+pub fn heat_color(t: f64) -> Color32 {
     const STOPS: [[f64; 3]; 5] = [
         [0.0, 0.0, 0.05],
         [0.1, 0.2, 0.8],

@@ -63,7 +63,8 @@ impl Integrator for PathIntegrator {
         let sample_index = self.passes;
         let (tracer, kind, seed) = (self.tracer, self.sampler, self.seed);
         let size = (self.film.width, self.film.height);
-        let completed = pass::add_samples_adaptive(&mut self.film, cancel, self.adaptive_threshold, |x, y| {
+        let pixels = self.settings.sampled_pixels();
+        let completed = pass::add_samples_adaptive(&mut self.film, pixels, cancel, self.adaptive_threshold, |x, y| {
             let mut sampler = Sampler::new(kind, y as u64 * size.0 as u64 + x as u64, sample_index, seed);
             let ray = camera_ray(camera, size, x, y, &mut sampler);
             tracer.radiance(scene, ray, &mut sampler)
@@ -71,10 +72,15 @@ impl Integrator for PathIntegrator {
         if completed {
             self.passes += 1;
             // A stopped pixel stays stopped (its state no longer changes), so
-            // once all are, every later pass would be empty.
-            self.converged = self
-                .adaptive_threshold
-                .is_some_and(|threshold| self.film.pixels.par_iter().all(|p| pass::is_converged(p, threshold)));
+            // once all that are sampled are, every later pass would be empty.
+            let width = self.film.width as usize;
+            let converged =
+                |threshold| {
+                    self.film.pixels.par_iter().enumerate().all(|(i, p)| {
+                        !pixels.contains((i % width) as u32, (i / width) as u32) || pass::is_converged(p, threshold)
+                    })
+                };
+            self.converged = self.adaptive_threshold.is_some_and(converged);
         }
         completed
     }
@@ -93,6 +99,10 @@ impl Integrator for PathIntegrator {
 
     fn frame(&self) -> Frame {
         self.film.frame()
+    }
+
+    fn sample_counts(&self) -> Option<Vec<u32>> {
+        Some(self.film.pixels.iter().map(|p| p.count).collect())
     }
 
     fn rejected_samples(&self) -> u64 {

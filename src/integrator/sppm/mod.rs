@@ -167,6 +167,7 @@ impl SppmIntegrator {
         let (kind, seed, iteration, max_depth) = (self.sampler, self.seed, self.iterations, self.max_depth);
         let size = (self.width, self.height);
         let initial_radius = InitialRadius::new(&self.parameters, camera, self.height);
+        let sampled = self.settings.sampled_pixels();
         let rejected = AtomicU64::new(0);
         let visible: Vec<Option<VisiblePoint>> = self
             .pixels
@@ -177,6 +178,9 @@ impl SppmIntegrator {
                     return None;
                 }
                 let (x, y) = (index as u32 % size.0, index as u32 / size.0);
+                if !sampled.contains(x, y) {
+                    return None;
+                }
                 let mut sampler = Sampler::new(kind, index as u64, iteration, seed);
                 let ray = camera_ray(camera, size, x, y, &mut sampler);
                 let path = trace_camera_path(scene, ray, &mut sampler, max_depth);
@@ -346,11 +350,14 @@ impl Integrator for SppmIntegrator {
         Some(self.radii())
     }
 
+    fn estimates_noise(&self) -> bool {
+        false
+    }
+
     fn status(&self) -> String {
         let (photons_per_second, iterations_per_second) = self.throughput();
         format!(
-            "iteration {}, mean radius {:.3e}, {:.2} Mphotons/s, {:.2} iterations/s",
-            self.iterations,
+            "mean radius {:.3e}, {:.2} Mphotons/s, {:.2} iterations/s",
             self.mean_radius(),
             photons_per_second / 1e6,
             iterations_per_second
