@@ -164,7 +164,7 @@ fn view_command(scene: Option<PathBuf>) -> Result<()> {
 /// A headless build (without the `viewer` feature) has no viewer to open.
 #[cfg(not(feature = "viewer"))]
 fn view_command(_scene: Option<PathBuf>) -> Result<()> {
-    bail!(
+    anyhow::bail!(
         "this prism was built without the viewer (cargo feature `viewer`); \
          render headless with `prism render`, or rebuild with the default features to get the viewer"
     )

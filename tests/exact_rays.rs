@@ -18,7 +18,6 @@
 use glam::DVec3;
 use num_bigint::BigInt;
 use num_traits::{Signed, Zero};
-use prism::accel::TraversalRay;
 use prism::bench::scaling::sphere_mesh;
 use prism::geometry::triangle::TriangleRay;
 use prism::math::Ray;
@@ -340,7 +339,7 @@ fn rays_at_vertices_visit_every_leaf_the_triangle_test_hits() {
             // The BVH's traversal, recording every face of every leaf it visits.
             let mut visited = Vec::new();
             let mut t = f64::INFINITY;
-            scene.bvh().traverse(&TraversalRay::new(&ray), &mut t, |leaf, t_max| {
+            scene.bvh().traverse(&ray, &mut t, |leaf, t_max| {
                 visited.extend((leaf.first..leaf.first + leaf.count).map(|k| scene.triangles().source(k).face));
                 if let Some(found) = scene
                     .triangles()

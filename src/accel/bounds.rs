@@ -80,6 +80,38 @@ fn pick_max(a: f32, b: f32) -> f32 {
     if a > b { a } else { b }
 }
 
+/// The largest `f32` not above `x` and the smallest not below it (equal
+/// when `x` is an `f32`), from one conversion and the neighbours' bit
+/// patterns, without branches (ray origins are finite and within `f32`'s
+/// range, which the scene's coordinate limit ensures).
+#[inline(always)]
+pub fn bracket(x: f64) -> (f32, f32) {
+    let rounded = x as f32;
+    let back = f64::from(rounded);
+    let bits = rounded.to_bits();
+    let negative = bits >> 31 != 0;
+    let zero = bits << 1 == 0;
+    // One ulp towards +∞ and towards −∞ (a zero's neighbours are the
+    // smallest subnormals).
+    let above = if zero {
+        1
+    } else if negative {
+        bits - 1
+    } else {
+        bits + 1
+    };
+    let below = if zero {
+        0x8000_0001
+    } else if negative {
+        bits + 1
+    } else {
+        bits - 1
+    };
+    let down = if back > x { f32::from_bits(below) } else { rounded };
+    let up = if back < x { f32::from_bits(above) } else { rounded };
+    (down, up)
+}
+
 /// The largest `f32` not above `x`.
 pub fn round_down(x: f64) -> f32 {
     let rounded = x as f32;
@@ -102,10 +134,14 @@ mod tests {
 
     #[test]
     fn outward_rounding_brackets_the_value() {
-        for x in [0.1, -0.1, 1e-30, -7.3e12, 1.0 / 3.0, 3.0, 1e300, -1e300] {
+        for x in [0.1, -0.1, 1e-30, -7.3e12, 1.0 / 3.0, 3.0, 1e-50, -1e-50, 0.0, -0.0] {
             let (down, up) = (round_down(x), round_up(x));
+            assert_eq!(bracket(x), (down, up), "{x}");
             assert!(f64::from(down) <= x && x <= f64::from(up), "{x}: {down} {up}");
             assert!(up == down || up == down.next_up(), "{x}: one ulp apart");
+        }
+        for x in [1e300, -1e300] {
+            assert!(f64::from(round_down(x)) <= x && x <= f64::from(round_up(x)));
         }
         assert_eq!(round_down(0.5), 0.5);
         assert_eq!(round_up(0.5), 0.5);

@@ -29,15 +29,6 @@ const PARALLEL_THRESHOLD: usize = 8192;
 /// Cost of one traversal step in units of one primitive test: a four-wide
 /// node tests four boxes at once, about what one triangle test costs.
 const TRAVERSAL_COST: f32 = 1.0;
-fn tc() -> f32 {
-    static T: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
-    *T.get_or_init(|| {
-        std::env::var("PRISM_TC")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(TRAVERSAL_COST)
-    })
-}
 /// Depth beyond which splits are made at the object median.
 const MAX_SAH_DEPTH: usize = 48;
 /// Most primitives any leaf may hold (the BVH encodes counts 1 to 4).
@@ -319,7 +310,7 @@ fn choose_split(items: &mut [BuildItem], range: &Range, max_leaf_size: &[usize])
         }
     }
     let (best_cost, axis, plane) = best;
-    let split_cost = tc() + best_cost / range.bounds.half_area().max(f32::MIN_POSITIVE);
+    let split_cost = TRAVERSAL_COST + best_cost / range.bounds.half_area().max(f32::MIN_POSITIVE);
     if leaf_allowed && split_cost >= count as f32 {
         return None;
     }

@@ -19,6 +19,7 @@
 use super::bounds::{Bounds32, round_up};
 use super::build::{self, BinaryContent, BinaryNode, Box4, BuildItem, MAX_LEAF_SIZE};
 use crate::math::{Aabb, Ray};
+use arrayvec::ArrayVec;
 use wide::{CmpLe, f32x4};
 
 /// Children per node.
@@ -195,22 +196,39 @@ impl Bvh {
 
     /// Visits the leaves `ray` enters, nearest first, skipping those beyond
     /// `*t_max`. `visit` tests a leaf's primitives, lowers `*t_max` to the
-    /// nearest hit it finds, and returns true to end the traversal (any-hit
-    /// queries stop at the first hit).
+    /// nearest hit it finds, and returns true to end the traversal.
     #[inline]
-    pub fn traverse(&self, ray: &TraversalRay, t_max: &mut f64, visit: impl FnMut(Leaf, &mut f64) -> bool) {
+    pub fn traverse(&self, ray: &Ray, t_max: &mut f64, visit: impl FnMut(Leaf, &mut f64) -> bool) {
+        self.traverse_sized::<true>(ray, t_max, visit);
+    }
+
+    /// Visits the leaves `ray` enters in any order (no sorting) until
+    /// `visit` returns true: for any-hit (occlusion) queries.
+    #[inline]
+    pub fn traverse_unordered(&self, ray: &Ray, t_max: &mut f64, visit: impl FnMut(Leaf, &mut f64) -> bool) {
+        self.traverse_sized::<false>(ray, t_max, visit);
+    }
+
+    /// A fixed stack when the tree's depth allows, else a growable one.
+    #[inline(always)]
+    fn traverse_sized<const NEAREST_FIRST: bool>(&self, ray: &Ray, t_max: &mut f64, visit: impl FnMut(Leaf, &mut f64) -> bool) {
         if self.nodes.is_empty() {
             return;
         }
-        if 3 * self.depth <= FIXED_STACK {
-            self.traverse_with(&mut FixedStack::new(), ray, t_max, visit);
+        // Prepared here, in this frame, so the 240-byte record is never copied.
+        let ray = &TraversalRay::new(ray);
+        let needed = 3 * self.depth;
+        if needed <= FIXED_STACK {
+            let mut stack = ArrayVec::<u64, FIXED_STACK>::new_const();
+            self.traverse_with::<NEAREST_FIRST>(&mut stack, ray, t_max, visit);
         } else {
-            self.traverse_with(&mut Vec::with_capacity(3 * self.depth), ray, t_max, visit);
+            let mut stack = Vec::with_capacity(needed);
+            self.traverse_with::<NEAREST_FIRST>(&mut stack, ray, t_max, visit);
         }
     }
 
     #[inline(always)]
-    fn traverse_with(
+    fn traverse_with<const NEAREST_FIRST: bool>(
         &self,
         stack: &mut impl TraversalStack,
         ray: &TraversalRay,
@@ -218,29 +236,48 @@ impl Bvh {
         mut visit: impl FnMut(Leaf, &mut f64) -> bool,
     ) {
         let mut limit = traversal_limit(*t_max);
-        // The child being visited: its reference and entry distance.
+        // The child being visited.
         let mut current = 0u32;
         loop {
             if current & LEAF_BIT == 0 {
                 let node = &self.nodes[current as usize];
                 let (t_near, hit) = ray.enter_children(node, limit);
-                // Entered children as keys that sort by entry distance (the
-                // distance's bits lead, and they order like the non-negative
-                // floats they are); the others sort last. A sorting network
-                // orders them without data-dependent branches.
-                // (`pack | (hit − 1)` is the key when hit and all ones when not.)
-                let mut keys: [u64; WIDTH] = std::array::from_fn(|lane| {
-                    pack(node.children[lane], t_near[lane]) | u64::from((hit >> lane) & 1).wrapping_sub(1)
-                });
-                let entered = hit.count_ones() as usize;
-                if entered > 0 {
-                    sort4(&mut keys);
-                    // Leave the farther ones for later, farthest deepest; go on with the nearest.
-                    for &key in keys[1..entered].iter().rev() {
-                        stack.push(key);
+                match hit.count_ones() {
+                    0 => {}
+                    1 => {
+                        // The common case needs no ordering.
+                        current = node.children[hit.trailing_zeros() as usize];
+                        continue;
                     }
-                    current = keys[0] as u32;
-                    continue;
+                    entered if NEAREST_FIRST => {
+                        // Entered children as keys that sort by entry distance
+                        // (the distance's bits lead, and they order like the
+                        // non-negative floats they are); the others (`pack |
+                        // (hit − 1)` is all ones for them) sort last. A sorting
+                        // network orders them without data-dependent branches.
+                        let mut keys: [u64; WIDTH] = std::array::from_fn(|lane| {
+                            pack(node.children[lane], t_near[lane]) | u64::from((hit >> lane) & 1).wrapping_sub(1)
+                        });
+                        sort4(&mut keys);
+                        // Leave the farther ones for later, farthest deepest; go on with the nearest.
+                        for &key in keys[1..entered as usize].iter().rev() {
+                            stack.push(key);
+                        }
+                        current = keys[0] as u32;
+                        continue;
+                    }
+                    _ => {
+                        // Any order will do: the first entered now, the others later.
+                        let mut remaining = hit;
+                        current = node.children[remaining.trailing_zeros() as usize];
+                        remaining &= remaining - 1;
+                        while remaining != 0 {
+                            let lane = remaining.trailing_zeros() as usize;
+                            stack.push(pack(node.children[lane], t_near[lane]));
+                            remaining &= remaining - 1;
+                        }
+                        continue;
+                    }
                 }
             } else {
                 let leaf = Leaf {
@@ -299,33 +336,18 @@ trait TraversalStack {
     fn pop(&mut self) -> Option<u64>;
 }
 
-/// A fixed array on the call stack: no allocation; 512 bytes to clear.
-struct FixedStack {
-    entries: [u64; FIXED_STACK],
-    len: usize,
-}
-
-impl FixedStack {
-    #[inline(always)]
-    fn new() -> Self {
-        Self {
-            entries: [0; FIXED_STACK],
-            len: 0,
-        }
-    }
-}
-
-impl TraversalStack for FixedStack {
+/// A fixed-capacity array on the call stack: no allocation and, unlike a
+/// plain array, nothing to clear first.
+impl<const N: usize> TraversalStack for ArrayVec<u64, N> {
     #[inline(always)]
     fn push(&mut self, entry: u64) {
-        self.entries[self.len] = entry;
-        self.len += 1;
+        // The tree's depth bounds the entries (checked when the size is chosen).
+        ArrayVec::push(self, entry);
     }
 
     #[inline(always)]
     fn pop(&mut self) -> Option<u64> {
-        self.len = self.len.checked_sub(1)?;
-        Some(self.entries[self.len])
+        ArrayVec::pop(self)
     }
 }
 
@@ -383,37 +405,29 @@ pub struct TraversalRay {
 }
 
 impl TraversalRay {
+    #[inline(always)]
     pub fn new(ray: &Ray) -> Self {
-        let mut prepared = TraversalRay {
-            entry_origin: [f32x4::ZERO; 3],
-            exit_origin: [f32x4::ZERO; 3],
-            reciprocal: [f32x4::ZERO; 3],
-            exit_reciprocal: [f32x4::ZERO; 3],
-            entry_plane: [0; 3],
-            exit_plane: [0; 3],
-        };
-        for axis in 0..3 {
-            let origin = ray.origin[axis];
-            let (down, up) = (super::bounds::round_down(origin), round_up(origin));
-            let reciprocal = (1.0 / ray.direction[axis]) as f32;
-            prepared.reciprocal[axis] = f32x4::splat(reciprocal);
+        let reciprocal: [f32; 3] = std::array::from_fn(|axis| (1.0 / ray.direction[axis]) as f32);
+        let bracket: [(f32, f32); 3] = std::array::from_fn(|axis| super::bounds::bracket(ray.origin[axis]));
+        let enters_through_minimum: [bool; 3] = std::array::from_fn(|axis| reciprocal[axis] >= 0.0);
+        TraversalRay {
+            // Entering through the minimum, (min − o)·r is smallest for the
+            // largest o; through the maximum (r < 0), for the smallest.
+            entry_origin: std::array::from_fn(|axis| {
+                let (down, up) = bracket[axis];
+                f32x4::splat(if enters_through_minimum[axis] { up } else { down })
+            }),
+            exit_origin: std::array::from_fn(|axis| {
+                let (down, up) = bracket[axis];
+                f32x4::splat(if enters_through_minimum[axis] { down } else { up })
+            }),
+            reciprocal: std::array::from_fn(|axis| f32x4::splat(reciprocal[axis])),
             // Four roundings in all ((b − o), r, r·scale, the product) stay
             // within 1 − 4u of exact, which the 1 + 2⁻²¹ scale covers.
-            prepared.exit_reciprocal[axis] = f32x4::splat(reciprocal * FAR_SCALE);
-            let (entry, exit) = if reciprocal >= 0.0 {
-                // Enters through the minimum: (min − o)·r is smallest for the largest o.
-                prepared.entry_plane[axis] = 2 * axis;
-                prepared.exit_plane[axis] = 2 * axis + 1;
-                (up, down)
-            } else {
-                prepared.entry_plane[axis] = 2 * axis + 1;
-                prepared.exit_plane[axis] = 2 * axis;
-                (down, up)
-            };
-            prepared.entry_origin[axis] = f32x4::splat(entry);
-            prepared.exit_origin[axis] = f32x4::splat(exit);
+            exit_reciprocal: std::array::from_fn(|axis| f32x4::splat(reciprocal[axis] * FAR_SCALE)),
+            entry_plane: std::array::from_fn(|axis| 2 * axis + usize::from(!enters_through_minimum[axis])),
+            exit_plane: std::array::from_fn(|axis| 2 * axis + usize::from(enters_through_minimum[axis])),
         }
-        prepared
     }
 
     /// Entry distances of the four children and a bit mask (bit i for
@@ -538,9 +552,8 @@ mod tests {
                 .iter()
                 .filter_map(|b| b.hit_distance(ray.origin, inverse, f64::INFINITY))
                 .fold(f64::INFINITY, f64::min);
-            let traversal = TraversalRay::new(&ray);
             let mut t_max = f64::INFINITY;
-            bvh.traverse(&traversal, &mut t_max, |leaf, t_max| {
+            bvh.traverse(&ray, &mut t_max, |leaf, t_max| {
                 for i in leaf.first..leaf.first + leaf.count {
                     let original = orders[leaf.kind as usize][i as usize] as usize;
                     if let Some(t) = boxes[original].hit_distance(ray.origin, inverse, *t_max) {
@@ -576,7 +589,7 @@ mod tests {
                 .filter_map(|b| b.hit_distance(ray.origin, inverse, f64::INFINITY))
                 .fold(f64::INFINITY, f64::min);
             let mut t_max = f64::INFINITY;
-            bvh.traverse(&TraversalRay::new(&ray), &mut t_max, |leaf, t_max| {
+            bvh.traverse(&ray, &mut t_max, |leaf, t_max| {
                 for k in leaf.first..leaf.first + leaf.count {
                     let original = orders[0][k as usize] as usize;
                     if let Some(t) = boxes[original].hit_distance(ray.origin, inverse, *t_max) {
@@ -608,7 +621,7 @@ mod tests {
         let count_leaves = |ray: Ray| {
             let mut visits = 0;
             let mut t_max = f64::INFINITY;
-            bvh.traverse(&TraversalRay::new(&ray), &mut t_max, |_, _| {
+            bvh.traverse(&ray, &mut t_max, |_, _| {
                 visits += 1;
                 false
             });

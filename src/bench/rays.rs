@@ -170,9 +170,6 @@ pub fn measure(
     let mut builds = Vec::new();
     let mut rows = Vec::new();
     for (name, mesh) in meshes {
-        if std::env::var("PRISM_ONLY").is_ok_and(|only| !only.split(',').any(|o| o == name)) {
-            continue;
-        }
         let scene = Scene::from_mesh(mesh.clone());
         let triangles = scene.primitive_count();
         let build_primitives: Vec<BuildPrimitive> = (0..triangles as u32)

@@ -73,7 +73,11 @@ impl TriangleRay {
         let e0 = p[1].x * p[2].y - p[1].y * p[2].x;
         let e1 = p[2].x * p[0].y - p[2].y * p[0].x;
         let e2 = p[0].x * p[1].y - p[0].y * p[1].x;
-        if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
+        // Mixed signs: a miss. (`|` and `&` on the six comparisons make one
+        // branch, not six barely predictable ones.)
+        let any_negative = (e0 < 0.0) | (e1 < 0.0) | (e2 < 0.0);
+        let any_positive = (e0 > 0.0) | (e1 > 0.0) | (e2 > 0.0);
+        if any_negative & any_positive {
             return None;
         }
         let det = e0 + e1 + e2;

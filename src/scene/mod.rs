@@ -17,7 +17,7 @@ pub use load::{COORDINATE_LIMIT, LoadedScene, load_scene_bytes, load_scene_file,
 pub use progress::{LoadStage, load_scene_file_with_progress};
 pub use similarity::{Similarity, load_scene_str_placed};
 
-use crate::accel::{BuildPrimitive, Bvh, TraversalRay};
+use crate::accel::{BuildPrimitive, Bvh};
 use crate::color::Color;
 use crate::geometry::triangle::TriangleRay;
 use crate::geometry::triangles::{LeafHit, TriangleSource, Triangles, store_mesh_positions, stored_position};
@@ -196,13 +196,12 @@ impl Scene {
     /// bounds) is built once, for the final hit.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<Intersection> {
-        let traversal = TraversalRay::new(ray);
         // The triangle test's per-ray constants, made when a triangle leaf is first reached.
         let mut triangle_ray: Option<TriangleRay> = None;
         let mut nearest_triangle: Option<LeafHit> = None;
         let mut nearest_shape: Option<Intersection> = None;
         let mut t = t_max;
-        self.bvh.traverse(&traversal, &mut t, |leaf, t_max| {
+        self.bvh.traverse(ray, &mut t, |leaf, t_max| {
             if leaf.kind == TRIANGLE_LEAF {
                 let triangle_ray = triangle_ray.get_or_insert_with(|| TriangleRay::new(ray));
                 if let Some(found) = self.triangles.intersect_leaf(triangle_ray, leaf.first, leaf.count, *t_max) {
@@ -236,11 +235,10 @@ impl Scene {
     /// at the first hit found.
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f64) -> bool {
-        let traversal = TraversalRay::new(ray);
         let mut triangle_ray: Option<TriangleRay> = None;
         let mut t = t_max;
         let mut found = false;
-        self.bvh.traverse(&traversal, &mut t, |leaf, t_max| {
+        self.bvh.traverse_unordered(ray, &mut t, |leaf, t_max| {
             found = if leaf.kind == TRIANGLE_LEAF {
                 let triangle_ray = triangle_ray.get_or_insert_with(|| TriangleRay::new(ray));
                 self.triangles.occludes_leaf(triangle_ray, leaf.first, leaf.count, *t_max)
