@@ -59,7 +59,6 @@ pub fn merge_command(args: MergeArgs) -> Result<()> {
             let mut metadata = vec![
                 ("Software".to_string(), format!("prism {}", env!("CARGO_PKG_VERSION"))),
                 ("Scene".to_string(), merged.header.scene.clone()),
-                ("MergedParts".to_string(), args.parts.len().to_string()),
                 ("Samples".to_string(), merged.samples_held.to_string()),
             ];
             for (name, key) in [
