@@ -68,8 +68,20 @@ pub fn scene_hash(scene: &Scene, camera: &Camera) -> String {
         }
     }
     for primitive in 0..scene.primitive_count() as u32 {
-        hash.debug(&scene.emitter(primitive));
-        hash.bytes(&scene.material_index(primitive).to_le_bytes());
+        match scene.triangle_source(primitive) {
+            // A triangle is a face of a mesh hashed above (the scene keeps
+            // mesh positions in the form its triangles are stored in):
+            // which face, and its material, say all.
+            Some(source) => {
+                for number in [source.mesh, source.face, source.material] {
+                    hash.bytes(&number.to_le_bytes());
+                }
+            }
+            None => {
+                hash.debug(&scene.emitter(primitive));
+                hash.bytes(&scene.material_index(primitive).to_le_bytes());
+            }
+        }
     }
     for material in &scene.materials {
         hash_material(&mut hash, material);

@@ -14,7 +14,8 @@
 //! (u32), the three colour sums (i128, zigzag-encoded, in units of 2⁻⁶⁴)
 //! and the squared-luminance sum (u128, in units of 2⁻³²), exactly as the
 //! film keeps them (`crate::film::ExactSums`). A pixel no sample reached
-//! takes 5 bytes; a typical one about 40 (fixed-width records would take 68).
+//! takes 5 bytes, one with a few samples about 20 (fixed-width records
+//! would take 68).
 //! Uncovered rows are stored like any other, so every film file is a whole
 //! image and merging is adding records.
 //!

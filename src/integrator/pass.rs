@@ -128,13 +128,20 @@ mod tests {
         let cancel = AtomicBool::new(false);
         let threshold = 0.1;
         for pass in 0..200u32 {
-            add_samples_adaptive(&mut film, PixelRect::full(2, 1), RowSet::ALL, &cancel, Some(threshold), |x, _| {
-                if x == 0 {
-                    Color::splat(0.5)
-                } else {
-                    Color::splat(2.0 * (pass % 2) as f64)
-                }
-            });
+            add_samples_adaptive(
+                &mut film,
+                PixelRect::full(2, 1),
+                RowSet::ALL,
+                &cancel,
+                Some(threshold),
+                |x, _| {
+                    if x == 0 {
+                        Color::splat(0.5)
+                    } else {
+                        Color::splat(2.0 * (pass % 2) as f64)
+                    }
+                },
+            );
         }
         assert_eq!(film.pixels[0].count, ADAPTIVE_MIN_SAMPLES);
         // After an even n of alternating 0/2 samples the mean is 1 and the
@@ -157,7 +164,9 @@ mod tests {
             x1: 4,
             y1: 3,
         };
-        add_samples_adaptive(&mut film, rect, RowSet::ALL, &cancel, None, |x, y| Color::new(x as f64, y as f64, 1.0));
+        add_samples_adaptive(&mut film, rect, RowSet::ALL, &cancel, None, |x, y| {
+            Color::new(x as f64, y as f64, 1.0)
+        });
         for y in 0..4 {
             for x in 0..5 {
                 let pixel = &film.pixels[(y * 5 + x) as usize];
