@@ -1,10 +1,10 @@
 //! `prism bench`: error against time (default), `--make-references`,
-//! `--scaling` and `--stress`. Argument handling and progress lines only; the
+//! `--scaling`, `--stress` and `--sppm-schedules`. Argument handling and progress lines only; the
 //! measurements live in the library's `bench` module.
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use prism::bench::{self, error_curves, plot, rays, scaling, stress, throughput};
+use prism::bench::{self, error_curves, plot, rays, scaling, sppm_schedules, stress, throughput};
 use prism::output::load_frame;
 use prism::scene::{self, LoadedScene};
 use std::path::{Path, PathBuf};
@@ -75,6 +75,16 @@ pub struct BenchArgs {
     /// Probe rays per scene or mesh in --stress.
     #[arg(long, default_value_t = 200_000)]
     stress_rays: u64,
+    /// Compare SPPM's per-pixel and global radius schedules at equal
+    /// iterations against each scene's reference instead (docs/farm.md).
+    #[arg(long)]
+    sppm_schedules: bool,
+    /// Last rung of --sppm-schedules' iteration ladder (1, 2, 4 …).
+    #[arg(long, default_value_t = 128)]
+    max_iterations: u32,
+    /// Seed of the --sppm-schedules renders.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
 }
 
 pub fn bench_command(args: BenchArgs) -> Result<()> {
@@ -90,6 +100,8 @@ pub fn bench_command(args: BenchArgs) -> Result<()> {
             throughput_command(&args)
         } else if args.stress {
             stress_command(&args)
+        } else if args.sppm_schedules {
+            sppm_schedules_command(&args)
         } else if args.scaling {
             scaling_command(&args)
         } else if let Some(seconds) = args.make_references {
@@ -344,6 +356,44 @@ fn stress_command(args: &BenchArgs) -> Result<()> {
     eprintln!("wrote {}; {failures} failures in total", path.display());
     if failures > 0 {
         bail!("{failures} stress failures");
+    }
+    Ok(())
+}
+
+fn sppm_schedules_command(args: &BenchArgs) -> Result<()> {
+    if !(1..=1 << 20).contains(&args.max_iterations) {
+        bail!("--max-iterations must be between 1 and {}", 1 << 20);
+    }
+    let ladder = sppm_schedules::iteration_ladder(args.max_iterations);
+    let files = if args.scenes.is_empty() {
+        vec![PathBuf::from("scenes/caustic.toml")]
+    } else {
+        args.scenes.clone()
+    };
+    for file in files {
+        let name = stem(&file);
+        let loaded = scene::load_scene_file(&file)?;
+        let reference_file = error_curves::reference_path(&args.references, &file);
+        let reference = load_frame(&reference_file).map_err(|e| anyhow::anyhow!("{e}"))?;
+        eprintln!(
+            "{name}: SPPM schedules at iterations {ladder:?}, {}x{}, {} photons per iteration",
+            reference.width, reference.height, loaded.settings.sppm.photons_per_iteration
+        );
+        let machine_before = bench::machine_note();
+        let rows = sppm_schedules::measure(&loaded, &reference, &ladder, args.seed, |row| {
+            eprintln!(
+                "  {:<9} {:>6} iterations: RMSE {:.5}, relMSE {:.5}, mean radius {:.4}",
+                row.schedule.to_string(),
+                row.iterations,
+                row.metrics.rmse,
+                row.metrics.relative_mse,
+                row.mean_radius
+            );
+        })?;
+        let machine = format!("before: {machine_before}; after: {}", bench::machine_note());
+        let path = args.output_dir.join(format!("sppm_schedules_{name}.csv"));
+        sppm_schedules::csv(&rows, &name, loaded.settings.sppm.photons_per_iteration, args.seed, &machine).write(&path)?;
+        eprintln!("wrote {}", path.display());
     }
     Ok(())
 }

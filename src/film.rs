@@ -1,32 +1,153 @@
-//! The film: per-pixel sums in f64 (f32 sums stop absorbing new samples after
-//! ~10⁷ of them), sample counts and the second moment the noise estimate needs;
-//! and `Frame`, the linear snapshot that viewers, image files and benchmarks read.
+//! The film: per-pixel sums, sample counts and the second moment the noise
+//! estimate needs; and `Frame`, the linear snapshot that viewers, image files
+//! and benchmarks read.
+//!
+//! Sums are kept in fixed point, in integers: integer addition is
+//! associative, so a pixel's sums do not depend on how its samples were
+//! grouped. That is what lets a render split into sample ranges on many
+//! machines merge into exactly the film one machine would have made
+//! (`crate::farm`); f64 sums would differ in their last bits, since
+//! (a + b) + c ≠ a + (b + c) in floating point. It also never stops absorbing
+//! samples, as f32 sums do after ~10⁷ of them.
+//!
+//! Units and limits (each sample is converted once, exactly where it can be):
+//! - colour sums: i128 with [`COLOR_FRACTION_BITS`] = 64 fractional bits, a
+//!   resolution of 2⁻⁶⁴ ≈ 5.4·10⁻²⁰ (samples ≥ 2⁻¹¹ convert without any
+//!   rounding, as their 53-bit mantissas fit);
+//! - squared luminance sum: u128 with [`SQUARE_FRACTION_BITS`] = 32
+//!   fractional bits (2.3·10⁻¹⁰ per sample; the noise estimate it feeds
+//!   compares variances of at least ~10⁻⁸ for the darkest pixel adaptive
+//!   sampling judges, see `integrator::pass`, so this is far below what it
+//!   could notice);
+//! - a sample is accepted if every channel is finite and below
+//!   [`MAX_SAMPLE_VALUE`] = 2³¹ in magnitude (radiance far beyond any scene's
+//!   lights); then even 2³² samples of the largest value fit in both sums.
+//!   Other samples are counted as rejected, as NaN ones always were.
 
 use crate::color::{Color, luminance, srgb_encode_8bit};
 
-/// Running sums of one pixel's samples.
-#[derive(Clone, Copy, Debug, Default)]
+/// Fractional bits of the colour sums (see the module doc).
+pub const COLOR_FRACTION_BITS: u32 = 64;
+/// Fractional bits of the squared-luminance sum (see the module doc).
+pub const SQUARE_FRACTION_BITS: u32 = 32;
+/// A sample channel must be below this in magnitude to be accepted: 2³¹.
+pub const MAX_SAMPLE_VALUE: f64 = 2_147_483_648.0;
+
+/// 2⁶⁴ and 2³², as f64 (exact).
+const TWO_POW_64: f64 = 18_446_744_073_709_551_616.0;
+const TWO_POW_32: f64 = 4_294_967_296.0;
+
+/// Whether a sample can be added: every channel finite and below
+/// [`MAX_SAMPLE_VALUE`] in magnitude.
+#[inline]
+pub fn accepts(sample: Color) -> bool {
+    // `max_element` skips NaN, so finiteness is checked first.
+    sample.is_finite() && sample.abs().max_element() < MAX_SAMPLE_VALUE
+}
+
+/// `value` (|value| < 2⁶³) in fixed point with 64 fractional bits, rounded
+/// toward zero. The whole part is truncated in an integer register and the
+/// fractional part (always exact in f64) scaled by a power of two, so the
+/// conversion is a few instructions rather than a 128-bit library call.
+#[inline]
+fn fixed_64(value: f64) -> i128 {
+    let magnitude = value.abs();
+    let whole = magnitude as u64;
+    let fraction = ((magnitude - whole as f64) * TWO_POW_64) as u64;
+    let fixed = (((whole as u128) << 64) | fraction as u128) as i128;
+    if value < 0.0 { -fixed } else { fixed }
+}
+
+/// A non-negative `value` (< 2⁶³) with 32 fractional bits, rounded toward zero.
+#[inline]
+fn fixed_32(value: f64) -> u128 {
+    let whole = value as u64;
+    let fraction = ((value - whole as f64) * TWO_POW_32) as u64;
+    ((whole as u128) << 32) | fraction as u128
+}
+
+/// Running sums of one pixel's samples, exact (see the module doc).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct PixelAccumulator {
-    pub sum: Color,
-    /// Sum of squared luminance, for the variance of the mean.
-    pub luminance_squared_sum: f64,
+    /// Σ sample per channel, in units of 2⁻⁶⁴.
+    sum: [i128; 3],
+    /// Σ luminance², in units of 2⁻³², for the variance of the mean.
+    luminance_squared_sum: u128,
+    pub count: u32,
+}
+
+/// A pixel's sums as the integers they are kept in: what film files store.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ExactSums {
+    /// Σ sample per channel, in units of 2⁻⁶⁴ ([`COLOR_FRACTION_BITS`]).
+    pub sum: [i128; 3],
+    /// Σ luminance², in units of 2⁻³² ([`SQUARE_FRACTION_BITS`]).
+    pub luminance_squared_sum: u128,
+    /// Samples added.
     pub count: u32,
 }
 
 impl PixelAccumulator {
+    /// Adds one sample if [`accepts`] it; returns whether it did.
     #[inline]
-    pub fn add(&mut self, sample: Color) {
-        self.sum += sample;
+    pub fn add(&mut self, sample: Color) -> bool {
+        if !accepts(sample) {
+            return false;
+        }
+        for (sum, value) in self.sum.iter_mut().zip(sample.to_array()) {
+            *sum = sum.wrapping_add(fixed_64(value));
+        }
         let y = luminance(sample);
-        self.luminance_squared_sum += y * y;
+        self.luminance_squared_sum = self.luminance_squared_sum.wrapping_add(fixed_32(y * y));
         self.count += 1;
+        true
+    }
+
+    /// Adds another accumulator's samples (exactly: the result does not
+    /// depend on the order of merges). `None`, leaving `self` unchanged, if
+    /// the count would pass `u32::MAX`.
+    pub fn merge(&mut self, other: &PixelAccumulator) -> Option<()> {
+        self.count = self.count.checked_add(other.count)?;
+        for (sum, other) in self.sum.iter_mut().zip(other.sum) {
+            *sum = sum.wrapping_add(other);
+        }
+        self.luminance_squared_sum = self.luminance_squared_sum.wrapping_add(other.luminance_squared_sum);
+        Some(())
+    }
+
+    /// The sums as stored.
+    pub fn exact_sums(&self) -> ExactSums {
+        ExactSums {
+            sum: self.sum,
+            luminance_squared_sum: self.luminance_squared_sum,
+            count: self.count,
+        }
+    }
+
+    /// An accumulator holding `sums` (e.g. read from a film file).
+    pub fn from_exact_sums(sums: ExactSums) -> Self {
+        Self {
+            sum: sums.sum,
+            luminance_squared_sum: sums.luminance_squared_sum,
+            count: sums.count,
+        }
+    }
+
+    /// Σ samples, as the nearest f64 per channel.
+    pub fn sum(&self) -> Color {
+        Color::from_array(self.sum.map(|s| s as f64 / TWO_POW_64))
+    }
+
+    /// Σ luminance², as the nearest f64.
+    pub fn luminance_squared_sum(&self) -> f64 {
+        self.luminance_squared_sum as f64 / TWO_POW_32
     }
 
     pub fn mean(&self) -> Color {
         if self.count == 0 {
             Color::ZERO
         } else {
-            self.sum / self.count as f64
+            self.sum() / self.count as f64
         }
     }
 
@@ -36,19 +157,29 @@ impl PixelAccumulator {
             return f64::INFINITY;
         }
         let n = self.count as f64;
-        let mean = luminance(self.sum) / n;
-        let variance = ((self.luminance_squared_sum - n * mean * mean) / (n - 1.0)).max(0.0);
+        let mean = luminance(self.sum()) / n;
+        let variance = ((self.luminance_squared_sum() - n * mean * mean) / (n - 1.0)).max(0.0);
         (variance / n).sqrt()
     }
 }
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Film {
     pub width: u32,
     pub height: u32,
     pub pixels: Vec<PixelAccumulator>,
-    /// Samples that came back NaN or infinite and were dropped.
+    /// Samples that came back NaN, infinite or beyond [`MAX_SAMPLE_VALUE`]
+    /// and were dropped.
     pub rejected_samples: u64,
+}
+
+/// Why two films cannot be added.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum FilmMergeError {
+    #[error("the films differ in size ({0}×{1} and {2}×{3})")]
+    Size(u32, u32, u32, u32),
+    #[error("pixel {0} would hold more than {max} samples", max = u32::MAX)]
+    CountOverflow(usize),
 }
 
 impl Film {
@@ -59,6 +190,25 @@ impl Film {
             pixels: vec![PixelAccumulator::default(); width as usize * height as usize],
             rejected_samples: 0,
         }
+    }
+
+    /// Adds another film's samples pixel by pixel. Exact and order-free: any
+    /// grouping of the same films gives the same bits. On error `self` may
+    /// be partly merged.
+    pub fn merge(&mut self, other: &Film) -> Result<(), FilmMergeError> {
+        if (self.width, self.height) != (other.width, other.height) {
+            return Err(FilmMergeError::Size(self.width, self.height, other.width, other.height));
+        }
+        for (index, (pixel, other)) in self.pixels.iter_mut().zip(&other.pixels).enumerate() {
+            pixel.merge(other).ok_or(FilmMergeError::CountOverflow(index))?;
+        }
+        self.rejected_samples = self.rejected_samples.saturating_add(other.rejected_samples);
+        Ok(())
+    }
+
+    /// Samples held, over all pixels.
+    pub fn sample_count(&self) -> u64 {
+        self.pixels.iter().map(|p| p.count as u64).sum()
     }
 
     /// The current estimate, linear.
@@ -143,6 +293,103 @@ mod tests {
         assert_eq!(p.mean(), Color::splat(2.0));
         // Sample variance of {1, 3} is 2; standard error sqrt(2/2) = 1.
         assert!((p.standard_error() - 1.0).abs() < 1e-12);
+    }
+
+    /// The sums do not depend on grouping: samples added one by one equal
+    /// any split merged back, bit for bit, for values f64 sums would round
+    /// differently ((0.1 + 0.2) + 0.3 ≠ 0.1 + (0.2 + 0.3) in f64).
+    #[test]
+    fn merged_accumulators_equal_one_accumulator_exactly() {
+        let samples: Vec<Color> = (0..97)
+            .map(|i| {
+                Color::new(
+                    0.1 * i as f64,
+                    1.0 / (1.0 + i as f64),
+                    1e-9 * (i * i) as f64 + 3e4 * (i % 3) as f64,
+                )
+            })
+            .collect();
+        let mut whole = PixelAccumulator::default();
+        for s in &samples {
+            assert!(whole.add(*s));
+        }
+        for split in [1, 13, 50, 96] {
+            let (mut first, mut second) = (PixelAccumulator::default(), PixelAccumulator::default());
+            samples[..split].iter().for_each(|s| assert!(first.add(*s)));
+            samples[split..].iter().for_each(|s| assert!(second.add(*s)));
+            // Merged in either order.
+            let mut a = first;
+            a.merge(&second).expect("no overflow");
+            let mut b = second;
+            b.merge(&first).expect("no overflow");
+            assert_eq!((a, b), (whole, whole), "split at {split}");
+        }
+        // f64 sums of the same groups do differ: the property is not vacuous.
+        let direct = samples.iter().fold(0.0, |s, c| s + c.y);
+        let grouped = samples[..13].iter().fold(0.0, |s, c| s + c.y) + samples[13..].iter().fold(0.0, |s, c| s + c.y);
+        assert_ne!(direct, grouped);
+    }
+
+    /// Fixed point with 64 fractional bits holds any sample ≥ 2⁻¹¹ without
+    /// rounding, so sums of such samples are exact where f64 would round;
+    /// smaller samples lose at most 2⁻⁶⁴ each.
+    #[test]
+    fn fixed_point_is_exact_where_promised() {
+        for value in [
+            0.1,
+            -0.1,
+            1.0 / 3.0,
+            12345.678,
+            2f64.powi(-11),
+            MAX_SAMPLE_VALUE - 1.0,
+            -(MAX_SAMPLE_VALUE - 0.5),
+        ] {
+            assert_eq!(fixed_64(value) as f64 / TWO_POW_64, value, "{value}");
+        }
+        for value in [1e-12, 3e-19, 7.77e-15] {
+            let error = (fixed_64(value) as f64 / TWO_POW_64 - value).abs();
+            assert!(error <= 1.0 / TWO_POW_64, "{value}: {error}");
+        }
+        assert_eq!(fixed_32(2.5) as f64 / TWO_POW_32, 2.5);
+        let mut p = PixelAccumulator::default();
+        for _ in 0..10 {
+            p.add(Color::splat(0.1));
+        }
+        // Ten exact copies of the f64 0.1 sum to exactly 10 × it, rounded once.
+        assert_eq!(p.sum(), Color::splat(10.0 * 0.1));
+    }
+
+    #[test]
+    fn unacceptable_samples_are_refused_and_not_counted() {
+        let mut p = PixelAccumulator::default();
+        for bad in [f64::NAN, f64::INFINITY, -f64::INFINITY, MAX_SAMPLE_VALUE, -1e300] {
+            assert!(!p.add(Color::new(1.0, bad, 1.0)), "{bad}");
+        }
+        assert_eq!(p, PixelAccumulator::default());
+        // The largest accepted value, 2³¹ times (by doubling merges), still
+        // sums exactly: (2³¹ − 1) · 2³¹ < 2⁶³ is within the colour sum's range.
+        let big = MAX_SAMPLE_VALUE - 1.0;
+        let mut many = PixelAccumulator::default();
+        assert!(many.add(Color::splat(big)));
+        for _ in 0..31 {
+            let copy = many;
+            many.merge(&copy).expect("fits");
+        }
+        assert_eq!((many.count, many.sum().x), (1 << 31, big * MAX_SAMPLE_VALUE));
+        // One more doubling passes u32::MAX samples and is refused.
+        let copy = many;
+        assert_eq!(many.merge(&copy), None);
+    }
+
+    #[test]
+    fn films_of_different_sizes_do_not_merge() {
+        let mut a = Film::new(2, 2);
+        assert_eq!(a.merge(&Film::new(2, 3)), Err(FilmMergeError::Size(2, 2, 2, 3)));
+        let mut full = Film::new(1, 1);
+        full.pixels[0].count = u32::MAX;
+        let mut one = Film::new(1, 1);
+        one.pixels[0].add(Color::ONE);
+        assert_eq!(full.merge(&one), Err(FilmMergeError::CountOverflow(0)));
     }
 
     #[test]

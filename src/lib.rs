@@ -7,7 +7,8 @@
 //! [`film::Frame`] → image file ([`output`]), viewer texture or benchmark error
 //! (the viewer may show a [`denoise`]d copy; the film is never filtered).
 //! [`render::ProgressiveRender`] is the one progressive driver the CLI, the
-//! viewer and the benchmarks share.
+//! viewer and the benchmarks share. [`farm`] splits a render across machines
+//! and merges the parts' films exactly.
 
 #![forbid(unsafe_code)]
 
@@ -16,6 +17,7 @@ pub mod bench;
 pub mod camera;
 pub mod color;
 pub mod denoise;
+pub mod farm;
 pub mod film;
 pub mod geometry;
 pub mod integrator;

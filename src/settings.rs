@@ -8,7 +8,7 @@
 
 pub mod validate;
 
-pub use crate::integrator::sppm::settings::SppmSettings;
+pub use crate::integrator::sppm::settings::{RadiusSchedule, SppmSettings};
 use crate::sampler::SamplerKind;
 use serde::{Deserialize, Serialize};
 use std::time::Duration;

@@ -60,9 +60,9 @@ fn fifteen_thousand_squared_is_refused_where_it_cannot_fit() {
     match prism::settings::validate::available_memory() {
         Some(available) if available < estimate => refused(
             &["--width", "15000", "--height", "15000"],
-            "error: --width: a 15000×15000 image with pt needs about 18.0 GB of memory",
+            "error: --width: a 15000×15000 image with pt needs about 27.0 GB of memory",
         ),
-        _ => eprintln!("skipped: this machine has room for an 18 GB render"),
+        _ => eprintln!("skipped: this machine has room for a 27 GB render"),
     }
 }
 

@@ -18,6 +18,7 @@ pub mod error_curves;
 pub mod plot;
 pub mod rays;
 pub mod scaling;
+pub mod sppm_schedules;
 pub mod stress;
 pub mod throughput;
 

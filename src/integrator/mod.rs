@@ -7,14 +7,19 @@
 //! - [`pass`]: the parallel pixel loop that per-pixel integrators share,
 //!   with adaptive sampling;
 //! - [`path`]: path tracing with light sampling and MIS, or BSDF sampling only;
-//! - [`sppm`]: stochastic progressive photon mapping.
+//! - [`sppm`]: stochastic progressive photon mapping;
+//! - [`share`]: which samples and rows a render computes (a whole image, or
+//!   one machine's part of a farm render).
 
 pub mod pass;
 pub mod path;
+pub mod share;
 pub mod sppm;
 
+pub use share::{RowSet, Share};
+
 use crate::camera::Camera;
-use crate::film::Frame;
+use crate::film::{Film, Frame};
 use crate::scene::Scene;
 use crate::settings::{IntegratorKind, RenderSettings};
 use std::sync::atomic::AtomicBool;
@@ -31,6 +36,14 @@ pub trait Integrator: Send {
 
     /// The current estimate.
     fn frame(&self) -> Frame;
+
+    /// The exact per-pixel sums behind [`frame`](Self::frame), for
+    /// integrators whose passes are independent estimates that add up (so
+    /// shares of a render can be merged); `None` for the others (SPPM with
+    /// its per-pixel radius update).
+    fn film(&self) -> Option<&Film> {
+        None
+    }
 
     /// A fresh integrator of the same kind for an image `divisor` times
     /// smaller on each axis, costing about 1/`divisor`² of a pass: the
@@ -77,9 +90,17 @@ pub trait Integrator: Send {
 
 /// The integrator the settings ask for.
 pub fn create(settings: &RenderSettings) -> Box<dyn Integrator> {
+    create_share(settings, &Share::whole(settings.samples_per_pixel.unwrap_or(0)))
+}
+
+/// The integrator the settings ask for, computing only `share`: its passes
+/// use the share's sample indices (or iterations) in order and sample only
+/// its rows. The caller stops it after [`Share::passes`] passes (or, with
+/// adaptive sampling, when it has converged).
+pub fn create_share(settings: &RenderSettings, share: &Share) -> Box<dyn Integrator> {
     match settings.integrator {
-        IntegratorKind::PathTracing | IntegratorKind::BsdfOnly => Box::new(path::PathIntegrator::new(settings)),
-        IntegratorKind::Sppm => Box::new(sppm::SppmIntegrator::new(settings)),
+        IntegratorKind::PathTracing | IntegratorKind::BsdfOnly => Box::new(path::PathIntegrator::with_share(settings, share)),
+        IntegratorKind::Sppm => Box::new(sppm::SppmIntegrator::with_share(settings, share)),
     }
 }
 

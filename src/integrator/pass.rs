@@ -9,8 +9,12 @@
 //! stays stopped, so each pixel's samples are a prefix of its sequence.
 //!
 //! A pass may cover only a rectangle of the image (the viewer's region
-//! render); pixels outside it are left as they are.
+//! render), and a render's share (`super::share`) only some rows; pixels
+//! outside them are left as they are. Since a pixel's activity depends on
+//! nothing outside it, the rows' shares of an adaptive render add up to
+//! exactly the whole render.
 
+use super::share::RowSet;
 use crate::color::{Color, luminance};
 use crate::film::{Film, PixelAccumulator};
 use crate::settings::PixelRect;
@@ -35,7 +39,7 @@ pub fn is_converged(pixel: &PixelAccumulator, threshold: f64) -> bool {
     if pixel.count < ADAPTIVE_MIN_SAMPLES {
         return false;
     }
-    let mean = luminance(pixel.sum) / pixel.count as f64;
+    let mean = luminance(pixel.sum()) / pixel.count as f64;
     pixel.standard_error() <= threshold * mean.max(ADAPTIVE_LUMINANCE_FLOOR)
 }
 
@@ -43,39 +47,43 @@ pub fn is_converged(pixel: &PixelAccumulator, threshold: f64) -> bool {
 pub fn add_samples(film: &mut Film, cancel: &AtomicBool, sample: impl Fn(u32, u32) -> Color + Sync) -> bool {
     let pixels = PixelRect::full(film.width, film.height);
     // `|_| true` is inlined away: the non-adaptive loop costs what it did.
-    add_samples_where(film, pixels, cancel, |_| true, sample)
+    add_samples_where(film, pixels, RowSet::ALL, cancel, |_| true, sample)
 }
 
-/// Adds one sample to each pixel of `pixels` that adaptive sampling with
-/// `threshold` has not stopped (see [`is_converged`]); `None` samples every one.
+/// Adds one sample to each pixel of `pixels` in `rows` that adaptive
+/// sampling with `threshold` has not stopped (see [`is_converged`]); `None`
+/// samples every one.
 pub fn add_samples_adaptive(
     film: &mut Film,
     pixels: PixelRect,
+    rows: RowSet,
     cancel: &AtomicBool,
     threshold: Option<f64>,
     sample: impl Fn(u32, u32) -> Color + Sync,
 ) -> bool {
     match threshold {
-        Some(threshold) => add_samples_where(film, pixels, cancel, |pixel| !is_converged(pixel, threshold), sample),
-        None => add_samples_where(film, pixels, cancel, |_| true, sample),
+        Some(threshold) => add_samples_where(film, pixels, rows, cancel, |pixel| !is_converged(pixel, threshold), sample),
+        None => add_samples_where(film, pixels, rows, cancel, |_| true, sample),
     }
 }
 
-/// Adds one sample to each pixel of `pixels` for which `active(pixel)`
-/// holds, judged on the pixel's state before this pass. Returns false if cancelled.
+/// Adds one sample to each pixel of `pixels` in `rows` for which
+/// `active(pixel)` holds, judged on the pixel's state before this pass.
+/// Returns false if cancelled.
 pub fn add_samples_where(
     film: &mut Film,
     pixels: PixelRect,
+    rows: RowSet,
     cancel: &AtomicBool,
     active: impl Fn(&PixelAccumulator) -> bool + Sync,
     sample: impl Fn(u32, u32) -> Color + Sync,
 ) -> bool {
     let width = film.width as usize;
-    let (columns, rows) = (pixels.x0 as usize..pixels.x1 as usize, pixels.y0 as usize..pixels.y1 as usize);
+    let (columns, lines) = (pixels.x0 as usize..pixels.x1 as usize, pixels.y0 as usize..pixels.y1 as usize);
     let rejected = AtomicU64::new(0);
     let film_rows = film.pixels.par_chunks_mut(width).enumerate();
-    film_rows.skip(rows.start).take(rows.len()).for_each(|(y, row)| {
-        if cancel.load(Ordering::Relaxed) {
+    film_rows.skip(lines.start).take(lines.len()).for_each(|(y, row)| {
+        if cancel.load(Ordering::Relaxed) || !rows.contains(y as u32) {
             return;
         }
         let mut row_rejected = 0;
@@ -94,11 +102,11 @@ pub fn add_samples_where(
     !cancel.load(Ordering::Relaxed)
 }
 
+/// Adds `value` unless the film refuses it (NaN, infinite or beyond
+/// `film::MAX_SAMPLE_VALUE`), which is counted instead.
 #[inline]
 fn add_finite(pixel: &mut PixelAccumulator, value: Color, rejected: &mut u64) {
-    if value.is_finite() {
-        pixel.add(value);
-    } else {
+    if !pixel.add(value) {
         *rejected += 1;
     }
 }
@@ -120,13 +128,20 @@ mod tests {
         let cancel = AtomicBool::new(false);
         let threshold = 0.1;
         for pass in 0..200u32 {
-            add_samples_adaptive(&mut film, PixelRect::full(2, 1), &cancel, Some(threshold), |x, _| {
-                if x == 0 {
-                    Color::splat(0.5)
-                } else {
-                    Color::splat(2.0 * (pass % 2) as f64)
-                }
-            });
+            add_samples_adaptive(
+                &mut film,
+                PixelRect::full(2, 1),
+                RowSet::ALL,
+                &cancel,
+                Some(threshold),
+                |x, _| {
+                    if x == 0 {
+                        Color::splat(0.5)
+                    } else {
+                        Color::splat(2.0 * (pass % 2) as f64)
+                    }
+                },
+            );
         }
         assert_eq!(film.pixels[0].count, ADAPTIVE_MIN_SAMPLES);
         // After an even n of alternating 0/2 samples the mean is 1 and the
@@ -149,7 +164,9 @@ mod tests {
             x1: 4,
             y1: 3,
         };
-        add_samples_adaptive(&mut film, rect, &cancel, None, |x, y| Color::new(x as f64, y as f64, 1.0));
+        add_samples_adaptive(&mut film, rect, RowSet::ALL, &cancel, None, |x, y| {
+            Color::new(x as f64, y as f64, 1.0)
+        });
         for y in 0..4 {
             for x in 0..5 {
                 let pixel = &film.pixels[(y * 5 + x) as usize];

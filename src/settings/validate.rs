@@ -10,7 +10,7 @@
 //! cannot fit in memory must be refused with an estimate, not end in an
 //! allocation failure.
 
-use super::{IntegratorKind, RenderSettings};
+use super::{IntegratorKind, RadiusSchedule, RenderSettings};
 use crate::sampler::SamplerKind;
 use serde::Deserialize;
 use std::fmt;
@@ -39,11 +39,11 @@ pub const MAX_EXPOSURE_STOPS: f64 = 64.0;
 /// density estimate's 1/(πr²) stay normal f64 numbers across it.
 pub const RADIUS_RANGE: (f64, f64) = (1e-12, 1e12);
 
-/// Bytes of memory per pixel that path tracing needs: the film's f64 sums and
-/// count (40), the linear frame with its noise estimate (16), 8-bit output and
+/// Bytes of memory per pixel that path tracing needs: the film's fixed-point
+/// sums and count (80, see `film`), the linear frame with its noise estimate (16), 8-bit output and
 /// its copy for the encoder (6), and room for the EXR encoder's f32 copy (12),
 /// rounded up.
-pub const PATH_TRACING_BYTES_PER_PIXEL: u64 = 80;
+pub const PATH_TRACING_BYTES_PER_PIXEL: u64 = 120;
 /// Bytes of memory per pixel that SPPM needs: its pixel statistics (64) and
 /// photon tallies (32), one pass's visible points (about 250) with their grid
 /// keys (a sphere covers up to 8 cells: 8 × 12 bytes, plus the point list of
@@ -66,6 +66,7 @@ pub enum Setting {
     PhotonsPerIteration,
     InitialRadius,
     Alpha,
+    RadiusSchedule,
     AdaptiveThreshold,
     Threads,
     Exposure,
@@ -85,6 +86,7 @@ impl Setting {
             Setting::PhotonsPerIteration => "photons_per_iteration",
             Setting::InitialRadius => "initial_radius",
             Setting::Alpha => "alpha",
+            Setting::RadiusSchedule => "radius_schedule",
             Setting::AdaptiveThreshold => "adaptive_threshold",
             Setting::TimeLimit | Setting::Threads | Setting::Exposure => return None,
         })
@@ -104,6 +106,7 @@ impl Setting {
             Setting::PhotonsPerIteration => "--photons",
             Setting::InitialRadius => "--radius",
             Setting::Alpha => "--alpha",
+            Setting::RadiusSchedule => "--radius-schedule",
             Setting::AdaptiveThreshold => "--adaptive-threshold",
             Setting::Threads => "--threads",
             Setting::Exposure => "--exposure",
@@ -151,6 +154,8 @@ pub struct SettingsPatch {
     pub photons_per_iteration: Option<u32>,
     pub initial_radius: Option<f64>,
     pub alpha: Option<f64>,
+    /// SPPM's radius schedule: "per-pixel" (default) or "global" (farm renders).
+    pub radius_schedule: Option<RadiusSchedule>,
     /// Relative standard error at which a pixel stops taking samples.
     pub adaptive_threshold: Option<f64>,
     /// Command line only: render for this long instead of to a sample count.
@@ -211,6 +216,7 @@ impl SettingsPatch {
             }
             next.sppm.alpha = alpha;
         }
+        next.sppm.radius_schedule = self.radius_schedule.unwrap_or(next.sppm.radius_schedule);
         if let Some(threshold) = self.adaptive_threshold {
             if !(threshold.is_finite() && threshold > 0.0) {
                 return Err(SettingError::new(
@@ -378,14 +384,14 @@ mod tests {
             height: 15_000,
             ..Default::default()
         };
-        // 2.25e8 pixels × 80 bytes = 18 GB.
-        assert_eq!(settings.memory_estimate(), 18_000_000_000);
+        // 2.25e8 pixels × 120 bytes = 27 GB.
+        assert_eq!(settings.memory_estimate(), 27_000_000_000);
         let error = settings.check_memory(Some(8_000_000_000)).err().map(|e| e.message);
         assert_eq!(
             error.as_deref(),
-            Some("a 15000×15000 image with pt needs about 18.0 GB of memory, more than the 8.0 GB available")
+            Some("a 15000×15000 image with pt needs about 27.0 GB of memory, more than the 8.0 GB available")
         );
-        assert!(settings.check_memory(Some(20_000_000_000)).is_ok());
+        assert!(settings.check_memory(Some(30_000_000_000)).is_ok());
         assert!(settings.check_memory(None).is_ok());
     }
 }

@@ -24,9 +24,11 @@ mod loader;
 mod panels;
 mod status;
 mod texture;
+mod watch;
 
 pub use app::{ViewKind, ViewerApp};
 pub use display::{CompareMode, DenoiseMode};
+pub use watch::{WatchApp, run_watch};
 
 use std::path::PathBuf;
 use std::time::Instant;

@@ -1,12 +1,14 @@
 //! Path tracing as a progressive integrator: one sample per pixel per pass
 //! through the shared pixel loop ([`super::pass`]); the per-sample tracer is
-//! in [`tracer`].
+//! in [`tracer`]. Pass k of a render whose share starts at sample A uses
+//! sample index A + k, so a share's film is exactly its samples of the
+//! whole render.
 
 pub mod tracer;
 
 pub use tracer::PathTracer;
 
-use super::{Integrator, pass};
+use super::{Integrator, RowSet, Share, pass};
 use crate::camera::Camera;
 use crate::film::{Film, Frame};
 use crate::math::Ray;
@@ -25,6 +27,10 @@ pub struct PathIntegrator {
     seed: u64,
     film: Film,
     passes: u32,
+    /// Sample index of the first pass.
+    first_sample: u32,
+    /// Rows this render samples.
+    rows: RowSet,
     adaptive_threshold: Option<f64>,
     /// Every pixel has met the adaptive threshold (see `Integrator::converged`).
     converged: bool,
@@ -32,6 +38,11 @@ pub struct PathIntegrator {
 
 impl PathIntegrator {
     pub fn new(settings: &RenderSettings) -> Self {
+        Self::with_share(settings, &Share::whole(settings.samples_per_pixel.unwrap_or(0)))
+    }
+
+    /// Renders only `share`: its sample indices, in order, on its rows.
+    pub fn with_share(settings: &RenderSettings, share: &Share) -> Self {
         Self {
             settings: settings.clone(),
             tracer: PathTracer::from_settings(settings),
@@ -39,13 +50,11 @@ impl PathIntegrator {
             seed: settings.seed,
             film: Film::new(settings.width, settings.height),
             passes: 0,
+            first_sample: share.samples.start,
+            rows: share.rows,
             adaptive_threshold: settings.adaptive_threshold,
             converged: false,
         }
-    }
-
-    pub fn film(&self) -> &Film {
-        &self.film
     }
 }
 
@@ -60,11 +69,11 @@ pub fn camera_ray(camera: &Camera, (width, height): (u32, u32), x: u32, y: u32, 
 
 impl Integrator for PathIntegrator {
     fn render_pass(&mut self, scene: &Scene, camera: &Camera, cancel: &AtomicBool) -> bool {
-        let sample_index = self.passes;
+        let sample_index = self.first_sample + self.passes;
         let (tracer, kind, seed) = (self.tracer, self.sampler, self.seed);
         let size = (self.film.width, self.film.height);
-        let pixels = self.settings.sampled_pixels();
-        let completed = pass::add_samples_adaptive(&mut self.film, pixels, cancel, self.adaptive_threshold, |x, y| {
+        let (pixels, rows) = (self.settings.sampled_pixels(), self.rows);
+        let completed = pass::add_samples_adaptive(&mut self.film, pixels, rows, cancel, self.adaptive_threshold, |x, y| {
             let mut sampler = Sampler::new(kind, y as u64 * size.0 as u64 + x as u64, sample_index, seed);
             let ray = camera_ray(camera, size, x, y, &mut sampler);
             tracer.radiance(scene, ray, &mut sampler)
@@ -74,12 +83,17 @@ impl Integrator for PathIntegrator {
             // A stopped pixel stays stopped (its state no longer changes), so
             // once all that are sampled are, every later pass would be empty.
             let width = self.film.width as usize;
-            let converged =
-                |threshold| {
-                    self.film.pixels.par_iter().enumerate().all(|(i, p)| {
-                        !pixels.contains((i % width) as u32, (i / width) as u32) || pass::is_converged(p, threshold)
-                    })
-                };
+            let sampled = |i: usize| {
+                let (x, y) = ((i % width) as u32, (i / width) as u32);
+                pixels.contains(x, y) && rows.contains(y)
+            };
+            let converged = |threshold| {
+                self.film
+                    .pixels
+                    .par_iter()
+                    .enumerate()
+                    .all(|(i, p)| !sampled(i) || pass::is_converged(p, threshold))
+            };
             self.converged = self.adaptive_threshold.is_some_and(converged);
         }
         completed
@@ -101,6 +115,10 @@ impl Integrator for PathIntegrator {
         self.film.frame()
     }
 
+    fn film(&self) -> Option<&Film> {
+        Some(&self.film)
+    }
+
     fn sample_counts(&self) -> Option<Vec<u32>> {
         Some(self.film.pixels.iter().map(|p| p.count).collect())
     }
@@ -113,8 +131,14 @@ impl Integrator for PathIntegrator {
         match self.adaptive_threshold {
             Some(_) if self.converged => "adaptive: converged, 0% of pixels active".to_string(),
             Some(threshold) => {
-                let converged = self.film.pixels.iter().filter(|p| pass::is_converged(p, threshold)).count();
-                let active = 100.0 * (1.0 - converged as f64 / self.film.pixels.len().max(1) as f64);
+                let width = self.film.width as usize;
+                let (mut total, mut converged) = (0usize, 0usize);
+                let rows = self.film.pixels.chunks(width).enumerate();
+                for (_, row) in rows.filter(|(y, _)| self.rows.contains(*y as u32)) {
+                    total += row.len();
+                    converged += row.iter().filter(|p| pass::is_converged(p, threshold)).count();
+                }
+                let active = 100.0 * (1.0 - converged as f64 / total.max(1) as f64);
                 format!("adaptive: {active:.0}% of pixels active")
             }
             None => String::new(),

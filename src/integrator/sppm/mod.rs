@@ -6,11 +6,18 @@
 //! 2. a hash grid over the visible points' gather spheres ([`grid`]);
 //! 3. photon pass: photons from the lights, each adding its BSDF-weighted
 //!    flux to every visible point whose sphere contains it ([`photon`]);
-//! 4. per-pixel progressive radius reduction ([`statistics`]).
+//! 4. the estimate: by default, per-pixel progressive radius reduction
+//!    ([`statistics`]); with the global radius schedule ([`radius`]), the
+//!    iteration's own estimate added to a film.
 //!
-//! The image is τ / (π R² · photons emitted) plus the emission camera paths
-//! saw along their specular chains, averaged over iterations (with a few
-//! extra camera paths per iteration for that cheap term). All light
+//! With the per-pixel schedule (Hachisuka & Jensen) the image is
+//! τ / (π R² · photons emitted) plus the emission camera paths saw along
+//! their specular chains, averaged over iterations (with a few extra camera
+//! paths per iteration for that cheap term). With the global schedule
+//! (Knaus & Zwicker 2011) every iteration i is a complete estimate, emission
+//! plus Φᵢ / (π rᵢ² · photons per iteration), and the image is their mean:
+//! iterations are independent, so a range of them renders on any machine and
+//! the ranges' films merge exactly (`crate::farm`). All light
 //! reflected diffusely (direct lighting included) comes from photons: the
 //! classic form, consistent as R → 0. A non-black background is a light
 //! like any other: seen directly and through glass by camera paths, and a
@@ -22,24 +29,28 @@
 
 pub mod grid;
 pub mod photon;
+pub mod radius;
 pub mod settings;
 pub mod statistics;
 pub mod visible_point;
 
-pub use settings::SppmSettings;
+pub use settings::{RadiusSchedule, SppmSettings};
 
-use super::Integrator;
 use super::path::camera_ray;
+use super::{Integrator, Share};
 use crate::camera::Camera;
-use crate::film::Frame;
+use crate::color::Color;
+use crate::film::{Film, Frame};
 use crate::math::DVec3;
 use crate::sampler::{Sampler, SamplerKind};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use grid::VisiblePointGrid;
 use photon::PhotonSources;
+use radius::{InitialRadius, global_area_scale};
 use rayon::prelude::*;
 use statistics::{PhotonTally, PixelStatistics};
+use std::f64::consts::PI;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 use visible_point::{VisiblePoint, trace_camera_path};
@@ -58,11 +69,6 @@ const EMISSION_SAMPLES: u32 = 4;
 /// Mixed into the seed of the extra emission paths' streams.
 const EMISSION_SEED: u64 = 0xe4e5_5101_7a11_c0de;
 
-/// Automatic initial radius, in pixel footprints at the visible point: about
-/// π·1.5² ≈ 7 pixels' worth of surface, enough photons per gather at the
-/// default photon count to keep the first iterations from being blotchy.
-const INITIAL_RADIUS_PIXELS: f64 = 1.5;
-
 /// Least cosine between the geometric normals of a visible point and a photon
 /// hit for the photon to count: rejects photons on another surface that
 /// happens to lie within the radius (the far side of a thin wall, the other
@@ -76,29 +82,34 @@ fn flux_unit(sources: &PhotonSources) -> f64 {
     sources.total_power().max(f64::MIN_POSITIVE)
 }
 
-/// The radius a pixel starts with: the absolute setting, or a few pixel
-/// footprints at the distance its first camera path travelled.
-struct InitialRadius {
-    absolute: Option<f64>,
-    /// Angle one pixel subtends (small-angle approximation of its footprint).
-    pixel_angle: f64,
+/// What the iterations have gathered, by radius schedule.
+enum Estimate {
+    /// Per-pixel schedule: Hachisuka & Jensen's statistics (N, R, τ).
+    Progressive(Vec<PixelStatistics>),
+    /// Global schedule: each iteration's estimate, one sample per pixel, and
+    /// the radii of the latest iteration (for the heatmap).
+    Independent { film: Film, radii: Vec<f64> },
 }
 
-impl InitialRadius {
-    fn new(parameters: &SppmSettings, camera: &Camera, height: u32) -> Self {
-        Self {
-            absolute: parameters.initial_radius,
-            pixel_angle: 2.0 * (camera.fov_y_degrees.to_radians() * 0.5).tan() / height as f64,
-        }
-    }
-
-    fn at_distance(&self, path_length: f64) -> f64 {
-        self.absolute
-            .unwrap_or((INITIAL_RADIUS_PIXELS * self.pixel_angle * path_length).max(1e-9))
-    }
+/// One pixel's camera pass: its visible point, and the emission its camera
+/// paths saw (`None` if that came out NaN or infinite); pixels outside the
+/// sampled region (the viewer's region render) are not sampled at all.
+#[derive(Clone, Copy, Debug)]
+struct CameraSample {
+    sampled: bool,
+    visible: Option<VisiblePoint>,
+    emitted: Option<Color>,
 }
 
-/// Progressive SPPM into per-pixel statistics.
+impl CameraSample {
+    const SKIPPED: CameraSample = CameraSample {
+        sampled: false,
+        visible: None,
+        emitted: None,
+    };
+}
+
+/// Progressive SPPM.
 pub struct SppmIntegrator {
     settings: RenderSettings,
     parameters: SppmSettings,
@@ -107,8 +118,10 @@ pub struct SppmIntegrator {
     seed: u64,
     width: u32,
     height: u32,
-    pixels: Vec<PixelStatistics>,
+    estimate: Estimate,
     tallies: Vec<PhotonTally>,
+    /// Index of the first iteration (a farm share may start past 0).
+    first_iteration: u32,
     iterations: u32,
     rejected: u64,
     photon_time: Duration,
@@ -117,7 +130,20 @@ pub struct SppmIntegrator {
 
 impl SppmIntegrator {
     pub fn new(settings: &RenderSettings) -> Self {
+        Self::with_share(settings, &Share::whole(settings.samples_per_pixel.unwrap_or(0)))
+    }
+
+    /// Renders iterations `share.samples` (SPPM samples whole images, so the
+    /// share's rows are not used: a farm splits SPPM by iterations).
+    pub fn with_share(settings: &RenderSettings, share: &Share) -> Self {
         let count = settings.pixel_count();
+        let estimate = match settings.sppm.radius_schedule {
+            RadiusSchedule::PerPixel => Estimate::Progressive(vec![PixelStatistics::default(); count]),
+            RadiusSchedule::Global => Estimate::Independent {
+                film: Film::new(settings.width, settings.height),
+                radii: vec![0.0; count],
+            },
+        };
         Self {
             settings: settings.clone(),
             parameters: settings.sppm,
@@ -126,8 +152,9 @@ impl SppmIntegrator {
             seed: settings.seed,
             width: settings.width,
             height: settings.height,
-            pixels: vec![PixelStatistics::default(); count],
+            estimate,
             tallies: (0..count).map(|_| PhotonTally::default()).collect(),
+            first_iteration: share.samples.start,
             iterations: 0,
             rejected: 0,
             photon_time: Duration::ZERO,
@@ -138,16 +165,19 @@ impl SppmIntegrator {
     /// Current gather radius per pixel, row-major (0 where no visible point
     /// has been found yet), for a heatmap.
     pub fn radii(&self) -> Vec<f32> {
-        self.pixels.iter().map(|p| p.radius as f32).collect()
+        match &self.estimate {
+            Estimate::Progressive(pixels) => pixels.iter().map(|p| p.radius as f32).collect(),
+            Estimate::Independent { radii, .. } => radii.iter().map(|&r| r as f32).collect(),
+        }
     }
 
     /// Mean radius over pixels that have one.
     pub fn mean_radius(&self) -> f64 {
         let (sum, count) = self
-            .pixels
-            .iter()
-            .filter(|p| p.radius > 0.0)
-            .fold((0.0, 0usize), |(s, n), p| (s + p.radius, n + 1));
+            .radii()
+            .into_iter()
+            .filter(|&r| r > 0.0)
+            .fold((0.0, 0usize), |(s, n), r| (s + r as f64, n + 1));
         if count == 0 { 0.0 } else { sum / count as f64 }
     }
 
@@ -161,25 +191,23 @@ impl SppmIntegrator {
         )
     }
 
-    /// Step 1: one camera path per pixel; records emission and returns the
-    /// visible points. Pixels get their initial radius at their first one.
-    fn camera_pass(&mut self, scene: &Scene, camera: &Camera, cancel: &AtomicBool) -> Vec<Option<VisiblePoint>> {
-        let (kind, seed, iteration, max_depth) = (self.sampler, self.seed, self.iterations, self.max_depth);
+    /// The index of the iteration being rendered (seeds its samples).
+    fn iteration(&self) -> u32 {
+        self.first_iteration + self.iterations
+    }
+
+    /// Step 1: one camera path per pixel (and a few more for the emitted
+    /// term) from the iteration's sample streams.
+    fn camera_pass(&self, scene: &Scene, camera: &Camera, cancel: &AtomicBool) -> Vec<CameraSample> {
+        let (kind, seed, iteration, max_depth) = (self.sampler, self.seed, self.iteration(), self.max_depth);
         let size = (self.width, self.height);
-        let initial_radius = InitialRadius::new(&self.parameters, camera, self.height);
         let sampled = self.settings.sampled_pixels();
-        let rejected = AtomicU64::new(0);
-        let visible: Vec<Option<VisiblePoint>> = self
-            .pixels
-            .par_iter_mut()
-            .enumerate()
-            .map(|(index, pixel)| {
-                if cancel.load(Ordering::Relaxed) {
-                    return None;
-                }
+        (0..self.width as usize * self.height as usize)
+            .into_par_iter()
+            .map(|index| {
                 let (x, y) = (index as u32 % size.0, index as u32 / size.0);
-                if !sampled.contains(x, y) {
-                    return None;
+                if cancel.load(Ordering::Relaxed) || !sampled.contains(x, y) {
+                    return CameraSample::SKIPPED;
                 }
                 let mut sampler = Sampler::new(kind, index as u64, iteration, seed);
                 let ray = camera_ray(camera, size, x, y, &mut sampler);
@@ -198,22 +226,54 @@ impl SppmIntegrator {
                     emitted += trace_camera_path(scene, ray, &mut sampler, max_depth).emitted;
                 }
                 let emitted = emitted / EMISSION_SAMPLES as f64;
-                if emitted.is_finite() {
-                    pixel.emitted_sum += emitted;
-                } else {
-                    rejected.fetch_add(1, Ordering::Relaxed);
+                CameraSample {
+                    sampled: true,
+                    visible: path.visible_point.filter(|vp| vp.throughput.is_finite()),
+                    emitted: emitted.is_finite().then_some(emitted),
                 }
-                let visible_point = path.visible_point.filter(|vp| vp.throughput.is_finite());
-                if pixel.radius == 0.0 {
-                    pixel.radius = visible_point
-                        .as_ref()
-                        .map_or(0.0, |vp| initial_radius.at_distance(vp.path_length));
-                }
-                visible_point
             })
-            .collect();
-        self.rejected += rejected.into_inner();
-        visible
+            .collect()
+    }
+
+    /// Step 1, continued: each pixel's gather radius for this iteration. The
+    /// per-pixel schedule records the emission and starts a pixel's radius at
+    /// its first visible point; the global one scales each visible point's
+    /// start radius by the iteration's factor.
+    fn radii_for_iteration(&mut self, camera: &Camera, samples: &[CameraSample]) -> Vec<f64> {
+        let initial_radius = InitialRadius::new(&self.parameters, camera, self.height);
+        let linear_scale = global_area_scale(self.iteration(), self.parameters.alpha).sqrt();
+        let mut rejected = 0;
+        let radii = match &mut self.estimate {
+            Estimate::Progressive(pixels) => pixels
+                .iter_mut()
+                .zip(samples)
+                .map(|(pixel, sample)| {
+                    match sample.emitted {
+                        Some(emitted) => pixel.emitted_sum += emitted,
+                        None if sample.sampled => rejected += 1,
+                        None => {}
+                    }
+                    if pixel.radius == 0.0 {
+                        pixel.radius = sample
+                            .visible
+                            .as_ref()
+                            .map_or(0.0, |vp| initial_radius.at_distance(vp.path_length));
+                    }
+                    pixel.radius
+                })
+                .collect(),
+            Estimate::Independent { .. } => samples
+                .iter()
+                .map(|sample| {
+                    sample
+                        .visible
+                        .as_ref()
+                        .map_or(0.0, |vp| initial_radius.at_distance(vp.path_length) * linear_scale)
+                })
+                .collect(),
+        };
+        self.rejected += rejected;
+        radii
     }
 
     /// Step 3: traces this iteration's photons in parallel, adding to the
@@ -222,11 +282,12 @@ impl SppmIntegrator {
         &self,
         scene: &Scene,
         sources: &PhotonSources,
-        visible: &[Option<VisiblePoint>],
+        visible: &[CameraSample],
+        radii: &[f64],
         grid: &VisiblePointGrid,
         cancel: &AtomicBool,
     ) -> bool {
-        let (kind, iteration, max_depth) = (self.sampler, self.iterations, self.max_depth);
+        let (kind, iteration, max_depth) = (self.sampler, self.iteration(), self.max_depth);
         let seed = self.seed ^ PHOTON_SEED;
         let inverse_unit = 1.0 / flux_unit(sources);
         (0..self.parameters.photons_per_iteration)
@@ -242,10 +303,10 @@ impl SppmIntegrator {
                 };
                 photon::trace(scene, emitted, &mut sampler, max_depth, |hit, towards_light, flux| {
                     for &pixel in grid.candidates(hit.point) {
-                        let Some(vp) = &visible[pixel as usize] else {
+                        let Some(vp) = &visible[pixel as usize].visible else {
                             continue;
                         };
-                        let radius = self.pixels[pixel as usize].radius;
+                        let radius = radii[pixel as usize];
                         if (vp.point - hit.point).length_squared() > radius * radius
                             || vp.geometric_normal.dot(hit.geometric_normal) < NORMAL_AGREEMENT
                             || towards_light.dot(vp.geometric_normal).signum() != vp.side()
@@ -261,25 +322,54 @@ impl SppmIntegrator {
         !cancel.load(Ordering::Relaxed)
     }
 
-    /// Step 4: folds each pixel's tally into its statistics.
-    fn update_statistics(&mut self, sources: &PhotonSources, visible: &[Option<VisiblePoint>]) {
+    /// Step 4: folds each pixel's tally into the estimate: the per-pixel
+    /// statistics, or this iteration's estimate added to the film.
+    fn update_estimate(&mut self, sources: &PhotonSources, visible: &[CameraSample], radii: Vec<f64>) {
         let alpha = self.parameters.alpha;
         let unit = flux_unit(sources);
+        // Photons emitted this iteration: the density estimate's denominator.
+        let photons = self.parameters.photons_per_iteration as f64;
         let rejected = AtomicU64::new(0);
-        self.pixels
-            .par_iter_mut()
-            .zip(self.tallies.par_iter_mut())
-            .zip(visible.par_iter())
-            .for_each(|((pixel, tally), vp)| {
-                let (flux, count) = tally.take(unit);
-                let Some(vp) = vp else { return };
-                let flux = vp.throughput * flux;
-                if flux.is_finite() {
-                    pixel.add_photons(flux, count, alpha);
-                } else {
-                    rejected.fetch_add(1, Ordering::Relaxed);
-                }
-            });
+        match &mut self.estimate {
+            Estimate::Progressive(pixels) => pixels
+                .par_iter_mut()
+                .zip(self.tallies.par_iter_mut())
+                .zip(visible.par_iter())
+                .for_each(|((pixel, tally), sample)| {
+                    let (flux, count) = tally.take(unit);
+                    let Some(vp) = &sample.visible else { return };
+                    let flux = vp.throughput * flux;
+                    if flux.is_finite() {
+                        pixel.add_photons(flux, count, alpha);
+                    } else {
+                        rejected.fetch_add(1, Ordering::Relaxed);
+                    }
+                }),
+            Estimate::Independent { film, radii: latest } => {
+                film.pixels
+                    .par_iter_mut()
+                    .zip(self.tallies.par_iter_mut())
+                    .zip(visible.par_iter().zip(radii.par_iter()))
+                    .for_each(|((pixel, tally), (sample, &radius))| {
+                        let (flux, _) = tally.take(unit);
+                        if !sample.sampled {
+                            return;
+                        }
+                        let Some(emitted) = sample.emitted else {
+                            rejected.fetch_add(1, Ordering::Relaxed);
+                            return;
+                        };
+                        let gathered = match &sample.visible {
+                            Some(vp) if radius > 0.0 => vp.throughput * flux / (PI * radius * radius * photons),
+                            _ => Color::ZERO,
+                        };
+                        if !pixel.add(emitted + gathered) {
+                            rejected.fetch_add(1, Ordering::Relaxed);
+                        }
+                    });
+                *latest = radii;
+            }
+        }
         self.rejected += rejected.into_inner();
     }
 
@@ -297,20 +387,22 @@ impl Integrator for SppmIntegrator {
         if cancel.load(Ordering::Relaxed) {
             return false;
         }
+        // Step 2: the grid over the gather spheres.
+        let radii = self.radii_for_iteration(camera, &visible);
         let points: Vec<(u32, DVec3, f64)> = visible
             .par_iter()
             .enumerate()
-            .filter_map(|(index, vp)| vp.as_ref().map(|vp| (index as u32, vp.point, self.pixels[index].radius)))
+            .filter_map(|(index, sample)| sample.visible.as_ref().map(|vp| (index as u32, vp.point, radii[index])))
             .collect();
         let grid = VisiblePointGrid::build(&points);
         let photons_start = Instant::now();
         let sources = PhotonSources::new(scene);
-        if !self.photon_pass(scene, &sources, &visible, &grid, cancel) {
+        if !self.photon_pass(scene, &sources, &visible, &radii, &grid, cancel) {
             self.clear_tallies();
             return false;
         }
         self.photon_time += photons_start.elapsed();
-        self.update_statistics(&sources, &visible);
+        self.update_estimate(&sources, &visible, radii);
         self.iterations += 1;
         self.total_time += start.elapsed();
         true
@@ -322,15 +414,24 @@ impl Integrator for SppmIntegrator {
 
     fn frame(&self) -> Frame {
         let (iterations, photons) = (self.iterations, self.parameters.photons_per_iteration);
-        Frame {
-            width: self.width,
-            height: self.height,
-            pixels: self
-                .pixels
-                .iter()
-                .map(|p| p.radiance(iterations, photons).as_vec3().to_array())
-                .collect(),
-            noise: Vec::new(),
+        match &self.estimate {
+            Estimate::Progressive(pixels) => Frame {
+                width: self.width,
+                height: self.height,
+                pixels: pixels
+                    .iter()
+                    .map(|p| p.radiance(iterations, photons).as_vec3().to_array())
+                    .collect(),
+                noise: Vec::new(),
+            },
+            Estimate::Independent { film, .. } => film.frame(),
+        }
+    }
+
+    fn film(&self) -> Option<&Film> {
+        match &self.estimate {
+            Estimate::Progressive(_) => None,
+            Estimate::Independent { film, .. } => Some(film),
         }
     }
 
@@ -350,8 +451,10 @@ impl Integrator for SppmIntegrator {
         Some(self.radii())
     }
 
+    /// The global schedule averages independent per-iteration estimates, so
+    /// its film has a noise estimate; the per-pixel one has none.
     fn estimates_noise(&self) -> bool {
-        false
+        matches!(self.estimate, Estimate::Independent { .. })
     }
 
     fn status(&self) -> String {
