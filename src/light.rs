@@ -118,6 +118,11 @@ impl Lights {
         }
     }
 
+    /// Number of lights.
+    pub fn len(&self) -> usize {
+        self.lights.len()
+    }
+
     pub fn is_empty(&self) -> bool {
         self.lights.is_empty()
     }

@@ -7,6 +7,15 @@
 //! the points scrambled by hashes of the pixel and dimension. Power-of-two
 //! prefixes of each pixel's sequence remain (0, m, 2)-nets, which is what
 //! lowers error at equal samples. `Random` draws independent uniforms.
+//!
+//! Only a path's first [`SOBOL_DIMENSIONS`] draws are Sobol' points; later
+//! ones are independent hashes, about a sixth of the cost. What
+//! stratification buys is concentrated in the integrand's low-dimensional
+//! projections (its "effective dimension", Caflisch, Morokoff & Owen 1997):
+//! the pixel, the lens and the first bounces. Deep bounces carry little
+//! light and gain little from stratification, so they get the cheap draws
+//! (Cycles, for one, also stops its low-discrepancy patterns after a few
+//! bounces).
 
 use glam::DVec2;
 
@@ -26,6 +35,11 @@ impl std::fmt::Display for SamplerKind {
         })
     }
 }
+
+/// Draws of a path taken from the Sobol' sequence (the camera's two 2D
+/// draws and the first two bounces' four draws each, light selection, light
+/// point, BSDF direction and lobe); the rest are independent.
+pub const SOBOL_DIMENSIONS: u32 = 10;
 
 /// The sample stream of one pixel sample (one camera path).
 #[derive(Clone, Debug)]
@@ -54,22 +68,35 @@ impl Sampler {
     pub fn next_1d(&mut self) -> f64 {
         let dimension_seed = self.next_dimension_seed();
         match self.kind {
-            SamplerKind::Sobol => {
+            SamplerKind::Sobol if self.dimension <= SOBOL_DIMENSIONS => {
                 // The scrambled van der Corput point of the shuffled index:
                 // nested_uniform_scramble(reverse(index)), written so that
                 // reversals cancel (see `shuffled_index`).
                 let index = self.shuffled_index(dimension_seed as u32);
                 to_unit(laine_karras_permutation(index, (dimension_seed >> 32) as u32).reverse_bits())
             }
-            SamplerKind::Random => to_unit(mix64(dimension_seed ^ self.sample_index as u64) as u32),
+            _ => to_unit(self.independent_bits(dimension_seed) as u32),
         }
+    }
+
+    /// One independent uniform value in [0, 1), whatever the kind: for
+    /// decisions that gain nothing from stratification (Russian roulette).
+    pub fn next_1d_independent(&mut self) -> f64 {
+        let dimension_seed = self.next_dimension_seed();
+        to_unit(self.independent_bits(dimension_seed) as u32)
+    }
+
+    /// 64 random bits for this stream's sample and dimension.
+    #[inline]
+    fn independent_bits(&self, dimension_seed: u64) -> u64 {
+        mix64(dimension_seed ^ self.sample_index as u64)
     }
 
     /// Two uniform values in [0, 1)², stratified together.
     pub fn next_2d(&mut self) -> DVec2 {
         let dimension_seed = self.next_dimension_seed();
         match self.kind {
-            SamplerKind::Sobol => {
+            SamplerKind::Sobol if self.dimension <= SOBOL_DIMENSIONS => {
                 let index = self.shuffled_index(dimension_seed as u32);
                 let scramble = mix64(dimension_seed);
                 // Sobol' dimensions 0 (reverse(index)) and 1, each Owen-scrambled:
@@ -79,8 +106,8 @@ impl Sampler {
                 let y = laine_karras_permutation(sobol_second_dimension_reversed(index), (scramble >> 32) as u32).reverse_bits();
                 DVec2::new(to_unit(x), to_unit(y))
             }
-            SamplerKind::Random => {
-                let bits = mix64(dimension_seed ^ self.sample_index as u64);
+            _ => {
+                let bits = self.independent_bits(dimension_seed);
                 DVec2::new(to_unit(bits as u32), to_unit((bits >> 32) as u32))
             }
         }

@@ -17,23 +17,7 @@ impl AxisBox {
 
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
-        let inverse = DVec3::ONE / ray.direction;
-        let t0 = (self.bounds.min - ray.origin) * inverse;
-        let t1 = (self.bounds.max - ray.origin) * inverse;
-        let near = t0.min(t1);
-        let far = t0.max(t1);
-        let (enter_axis, enter) = max_with_axis(near);
-        let (exit_axis, exit) = min_with_axis(far);
-        if enter > exit {
-            return None;
-        }
-        let (axis, t) = if enter > 0.0 && enter < t_max {
-            (enter_axis, enter)
-        } else if exit > 0.0 && exit < t_max && enter <= 0.0 {
-            (exit_axis, exit)
-        } else {
-            return None;
-        };
+        let (axis, t) = self.solve(ray, t_max)?;
         let mut point = ray.at(t);
         // Snap the coordinate of the face that was hit onto the face plane.
         let center = self.bounds.centroid();
@@ -55,6 +39,35 @@ impl AxisBox {
             shading_normal: normal,
             uv: self.face_uv(point, axis),
         })
+    }
+
+    /// Distance to the hit before `t_max`, without its record (shadow rays).
+    #[inline]
+    pub fn hit_distance(&self, ray: &Ray, t_max: f64) -> Option<f64> {
+        self.solve(ray, t_max).map(|(_, t)| t)
+    }
+
+    /// The slab test (Kay & Kajiya 1986): the axis of the face hit and the
+    /// distance to it; the exit face when the origin is inside.
+    #[inline]
+    fn solve(&self, ray: &Ray, t_max: f64) -> Option<(usize, f64)> {
+        let inverse = DVec3::ONE / ray.direction;
+        let t0 = (self.bounds.min - ray.origin) * inverse;
+        let t1 = (self.bounds.max - ray.origin) * inverse;
+        let near = t0.min(t1);
+        let far = t0.max(t1);
+        let (enter_axis, enter) = max_with_axis(near);
+        let (exit_axis, exit) = min_with_axis(far);
+        if enter > exit {
+            return None;
+        }
+        if enter > 0.0 && enter < t_max {
+            Some((enter_axis, enter))
+        } else if exit > 0.0 && exit < t_max && enter <= 0.0 {
+            Some((exit_axis, exit))
+        } else {
+            None
+        }
     }
 
     fn face_uv(&self, point: DVec3, axis: usize) -> DVec2 {

@@ -85,9 +85,9 @@ impl Shape {
     pub fn hit_distance(&self, ray: &Ray, t_max: f64) -> Option<f64> {
         match self {
             Shape::Triangle(t) => t.intersect_raw(ray, t_max).map(|h| h.t),
-            Shape::Sphere(s) => s.intersect(ray, t_max).map(|h| h.t),
-            Shape::AxisBox(b) => b.intersect(ray, t_max).map(|h| h.t),
-            Shape::Quad(q) => q.intersect(ray, t_max).map(|h| h.t),
+            Shape::Sphere(s) => s.hit_distance(ray, t_max),
+            Shape::AxisBox(b) => b.hit_distance(ray, t_max),
+            Shape::Quad(q) => q.hit_distance(ray, t_max),
             Shape::Revolution(r) => r.intersect(ray, t_max).map(|h| h.t),
         }
     }

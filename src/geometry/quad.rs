@@ -40,6 +40,30 @@ impl Quad {
     /// Plane hit, then the parallelogram coordinates by Cramer's rule.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
+        let (t, a, b) = self.solve(ray, t_max)?;
+        let point = self.corner + a * self.edge_u + b * self.edge_v;
+        let point_error = gamma(6) * (self.corner.abs() + (a * self.edge_u).abs() + (b * self.edge_v).abs());
+        Some(SurfaceHit {
+            t,
+            point,
+            point_error,
+            geometric_normal: self.normal,
+            shading_normal: self.normal,
+            uv: DVec2::new(a, b),
+        })
+    }
+
+    /// Distance to the hit before `t_max`, without its record (shadow rays).
+    #[inline]
+    pub fn hit_distance(&self, ray: &Ray, t_max: f64) -> Option<f64> {
+        self.solve(ray, t_max).map(|(t, _, _)| t)
+    }
+
+    /// The ray parameter and the hit's coordinates along the two edges
+    /// (Möller & Trumbore 1997, with the second barycentric test made a
+    /// parallelogram's: both coordinates in [0, 1]).
+    #[inline]
+    fn solve(&self, ray: &Ray, t_max: f64) -> Option<(f64, f64, f64)> {
         let p = ray.direction.cross(self.edge_v);
         let det = self.edge_u.dot(p);
         if det == 0.0 {
@@ -60,16 +84,7 @@ impl Quad {
         if !(t > 0.0 && t < t_max) {
             return None;
         }
-        let point = self.corner + a * self.edge_u + b * self.edge_v;
-        let point_error = gamma(6) * (self.corner.abs() + (a * self.edge_u).abs() + (b * self.edge_v).abs());
-        Some(SurfaceHit {
-            t,
-            point,
-            point_error,
-            geometric_normal: self.normal,
-            shading_normal: self.normal,
-            uv: DVec2::new(a, b),
-        })
+        Some((t, a, b))
     }
 
     /// Uniform point; density `1 / area`.

@@ -27,7 +27,7 @@ impl Sphere {
 
     /// Nearest hit in `(0, t_max)`.
     #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
+    pub fn hit_distance(&self, ray: &Ray, t_max: f64) -> Option<f64> {
         let f = ray.origin - self.center;
         let b = f.dot(ray.direction);
         let c = f.length_squared() - self.radius * self.radius;
@@ -43,13 +43,20 @@ impl Sphere {
             let a = c / q;
             if a < q { (a, q) } else { (q, a) }
         };
-        let t = if t0 > 0.0 && t0 < t_max {
-            t0
+        if t0 > 0.0 && t0 < t_max {
+            Some(t0)
         } else if t1 > 0.0 && t1 < t_max {
-            t1
+            Some(t1)
         } else {
-            return None;
-        };
+            None
+        }
+    }
+
+    /// The nearest hit before `t_max`, with its record (normal, uv, error
+    /// bounds). Shadow rays need only [`Sphere::hit_distance`], which skips
+    /// the record and its two inverse trigonometric functions.
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
+        let t = self.hit_distance(ray, t_max)?;
         Some(self.hit_at(ray.at(t), t))
     }
 

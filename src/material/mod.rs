@@ -110,6 +110,17 @@ impl Material {
         }
     }
 
+    /// Which of [`Material::sample`]'s random inputs it reads: the 2D
+    /// direction sample `u`, the 1D lobe choice `u_lobe`. A path draws only
+    /// these, so a mirror bounce costs no draws and a diffuse one no lobe draw.
+    pub fn sample_inputs(&self) -> (bool, bool) {
+        match self {
+            Material::Diffuse { .. } | Material::Glossy { .. } => (true, false),
+            Material::Glass { .. } => (false, true),
+            Material::Mirror { .. } | Material::Emissive { .. } => (false, false),
+        }
+    }
+
     /// Draws `wi` for the given `wo`; `u` picks the direction, `u_lobe` the lobe.
     pub fn sample(&self, wo: DVec3, at: &ShadingPoint, u: DVec2, u_lobe: f64, transport: Transport) -> Option<BsdfSample> {
         match self {

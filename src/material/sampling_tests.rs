@@ -316,3 +316,49 @@ fn mirror_obeys_the_law_of_reflection_on_both_sides() {
             .is_none()
     );
 }
+
+/// `sample_inputs` must name every input `sample` reads: paths skip the
+/// draws it says are unused, so changing an unused input must change nothing.
+#[test]
+fn sample_reads_only_the_inputs_it_declares() {
+    let tint = Texture::Constant(Color::new(0.9, 0.6, 0.3));
+    let materials = [
+        Material::Diffuse { albedo: tint.clone() },
+        Material::Glossy {
+            tint: tint.clone(),
+            roughness: 0.3,
+        },
+        Material::Mirror { tint },
+        Material::Glass {
+            ior: 1.5,
+            tint: Color::ONE,
+        },
+    ];
+    let inputs = [
+        (DVec2::new(0.1, 0.7), 0.02),
+        (DVec2::new(0.8, 0.3), 0.97),
+        (DVec2::new(0.45, 0.55), 0.5),
+    ];
+    for material in &materials {
+        let (uses_direction, uses_lobe) = material.sample_inputs();
+        for wo in [
+            direction(10.0, 0.3, false),
+            direction(70.0, 2.0, false),
+            direction(40.0, 1.0, true),
+        ] {
+            for &(u, u_lobe) in &inputs {
+                let reference = material.sample(wo, &at(), u, u_lobe, Transport::Radiance);
+                let other_u = if uses_direction { u } else { DVec2::new(0.999, 0.001) };
+                let other_lobe = if uses_lobe { u_lobe } else { 0.123 };
+                let varied = material.sample(wo, &at(), other_u, other_lobe, Transport::Radiance);
+                assert_eq!(format!("{reference:?}"), format!("{varied:?}"), "{material:?}");
+            }
+        }
+    }
+    // And the inputs declared used do matter.
+    let glass = &materials[3];
+    let wo = direction(30.0, 0.0, false);
+    let reflect = glass.sample(wo, &at(), DVec2::ZERO, 0.0, Transport::Radiance);
+    let refract = glass.sample(wo, &at(), DVec2::ZERO, 0.999, Transport::Radiance);
+    assert_ne!(format!("{reflect:?}"), format!("{refract:?}"));
+}

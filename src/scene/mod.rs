@@ -196,39 +196,61 @@ impl Scene {
     /// bounds) is built once, for the final hit.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<Intersection> {
+        /// The nearest hit so far. Candidates are compared by distance
+        /// alone; the hit record (normal, uv, error bounds) is built once,
+        /// for the nearest, except for surfaces of revolution, whose root
+        /// finding depends on the bound and so keeps the record it found.
+        enum Nearest {
+            Nothing,
+            Triangle(LeafHit),
+            Shape(u32, f64),
+            Record(Intersection),
+        }
         // The triangle test's per-ray constants, made when a triangle leaf is first reached.
         let mut triangle_ray: Option<TriangleRay> = None;
-        let mut nearest_triangle: Option<LeafHit> = None;
-        let mut nearest_shape: Option<Intersection> = None;
+        let mut nearest = Nearest::Nothing;
         let mut t = t_max;
         self.bvh.traverse(ray, &mut t, |leaf, t_max| {
             if leaf.kind == TRIANGLE_LEAF {
                 let triangle_ray = triangle_ray.get_or_insert_with(|| TriangleRay::new(ray));
                 if let Some(found) = self.triangles.intersect_leaf(triangle_ray, leaf.first, leaf.count, *t_max) {
                     *t_max = found.hit.t;
-                    nearest_triangle = Some(found);
-                    nearest_shape = None;
+                    nearest = Nearest::Triangle(found);
                 }
             } else {
                 for index in leaf.first..leaf.first + leaf.count {
-                    if let Some(hit) = self.shapes[index as usize].shape.intersect(ray, *t_max, &self.meshes) {
-                        *t_max = hit.t;
-                        nearest_shape = Some(Intersection { hit, primitive: index });
-                        nearest_triangle = None;
+                    let shape = &self.shapes[index as usize].shape;
+                    if let Shape::Revolution(revolution) = shape {
+                        if let Some(hit) = revolution.intersect(ray, *t_max) {
+                            *t_max = hit.t;
+                            nearest = Nearest::Record(Intersection { hit, primitive: index });
+                        }
+                    } else if let Some(t) = shape.hit_distance(ray, *t_max) {
+                        *t_max = t;
+                        nearest = Nearest::Shape(index, t);
                     }
                 }
             }
             false
         });
-        if let Some(found) = nearest_triangle {
-            let triangle = self.triangles.get(found.index);
-            let mesh = &self.meshes[triangle.mesh as usize];
-            return Some(Intersection {
-                hit: triangle.surface_hit(&found.hit, mesh),
-                primitive: self.shapes.len() as u32 + found.index,
-            });
+        match nearest {
+            Nearest::Nothing => None,
+            Nearest::Triangle(found) => {
+                let triangle = self.triangles.get(found.index);
+                let mesh = &self.meshes[triangle.mesh as usize];
+                Some(Intersection {
+                    hit: triangle.surface_hit(&found.hit, mesh),
+                    primitive: self.shapes.len() as u32 + found.index,
+                })
+            }
+            Nearest::Shape(index, t) => {
+                // The same arithmetic as `hit_distance`, so with the bound
+                // just above `t` it finds the same hit.
+                let hit = self.shapes[index as usize].shape.intersect(ray, t.next_up(), &self.meshes)?;
+                Some(Intersection { hit, primitive: index })
+            }
+            Nearest::Record(found) => Some(found),
         }
-        nearest_shape
     }
 
     /// Whether anything lies on the ray before `t_max` (shadow rays); stops

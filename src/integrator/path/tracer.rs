@@ -11,6 +11,7 @@ use crate::math::{Frame as ShadingFrame, Ray, max_component, warp::power_heurist
 use crate::sampler::Sampler;
 use crate::scene::Scene;
 use crate::settings::{IntegratorKind, RenderSettings};
+use glam::DVec2;
 
 /// Bounces before Russian roulette may end a path.
 const ROULETTE_START: u32 = 3;
@@ -78,7 +79,8 @@ impl PathTracer {
 
             // Next-event estimation: one light sample, MIS-weighted.
             if light_sampling && !material.is_specular() {
-                let u_select = sampler.next_1d();
+                // With one light there is nothing to select: no draw.
+                let u_select = if scene.lights.len() > 1 { sampler.next_1d() } else { 0.5 };
                 let u_light = sampler.next_2d();
                 if let Some(light) = scene.lights.sample(scene, hit.point, u_select, u_light) {
                     let wi = frame.to_local(light.wi);
@@ -97,8 +99,9 @@ impl PathTracer {
             }
 
             // Continue the path by sampling the BSDF.
-            let u = sampler.next_2d();
-            let u_lobe = sampler.next_1d();
+            let (uses_direction, uses_lobe) = material.sample_inputs();
+            let u = if uses_direction { sampler.next_2d() } else { DVec2::ZERO };
+            let u_lobe = if uses_lobe { sampler.next_1d() } else { 0.5 };
             let Some(sample) = material.sample(wo, &at, u, u_lobe, Transport::Radiance) else {
                 break;
             };
@@ -114,7 +117,7 @@ impl PathTracer {
             // Russian roulette: survive with probability ~ throughput.
             if bounce + 1 >= ROULETTE_START {
                 let survival = max_component(throughput).min(0.95);
-                if sampler.next_1d() >= survival {
+                if sampler.next_1d_independent() >= survival {
                     break;
                 }
                 throughput /= survival;
