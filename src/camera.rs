@@ -4,12 +4,21 @@
 use crate::math::{Ray, warp};
 use glam::{DVec2, DVec3};
 
+/// A look-at thin-lens camera in world space. The public fields are the
+/// user's parameters; after changing any of them call [`Camera::update`],
+/// which rebuilds the orthonormal basis (right = forward × up, so the world
+/// is right-handed and the image's x runs along `right`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
+    /// Centre of the lens (the eye), world space.
     pub position: DVec3,
     /// The point looked at; orbiting turns about it.
     pub target: DVec3,
+    /// Approximate up direction; only its component orthogonal to the view
+    /// axis matters, and it must not be parallel to it.
     pub up: DVec3,
+    /// Vertical field of view in degrees (the horizontal one follows from the
+    /// image's aspect ratio).
     pub fov_y_degrees: f64,
     /// Lens radius in scene units; 0 gives a pinhole.
     pub aperture_radius: f64,
@@ -30,6 +39,7 @@ struct Basis {
 }
 
 impl Camera {
+    /// A camera with no near clipping, its basis computed.
     pub fn new(position: DVec3, target: DVec3, up: DVec3, fov_y_degrees: f64, aperture_radius: f64, focal_distance: f64) -> Self {
         let mut camera = Self {
             position,
@@ -63,20 +73,23 @@ impl Camera {
         };
     }
 
+    /// Unit view direction, from `position` towards `target`.
     pub fn forward(&self) -> DVec3 {
         self.basis.forward
     }
 
+    /// Unit vector to the image's right.
     pub fn right(&self) -> DVec3 {
         self.basis.right
     }
 
+    /// Unit vector to the image's top: `up` made orthogonal to the view axis.
     pub fn view_up(&self) -> DVec3 {
         self.basis.up
     }
 
-    /// Primary ray through `film` ∈ [0,1]² (x right, y down) for an image of
-    /// the given aspect ratio (width / height); `lens` ∈ [0,1]² picks the
+    /// Primary ray through `film` ∈ \[0,1\]² (x right, y down) for an image of
+    /// the given aspect ratio (width / height); `lens` ∈ \[0,1\]² picks the
     /// point on the aperture.
     #[inline]
     pub fn generate_ray(&self, film: DVec2, aspect: f64, lens: DVec2) -> Ray {

@@ -73,6 +73,7 @@ pub struct PixelAccumulator {
     sum: [i128; 3],
     /// Σ luminance², in units of 2⁻³², for the variance of the mean.
     luminance_squared_sum: u128,
+    /// Samples added.
     pub count: u32,
 }
 
@@ -143,6 +144,7 @@ impl PixelAccumulator {
         self.luminance_squared_sum as f64 / TWO_POW_32
     }
 
+    /// The pixel's estimate: the mean of its samples (black before the first).
     pub fn mean(&self) -> Color {
         if self.count == 0 {
             Color::ZERO
@@ -163,10 +165,17 @@ impl PixelAccumulator {
     }
 }
 
+/// The accumulated samples of a whole image (or of a farm part's share of
+/// it). Integrators add samples to it; [`Film::frame`] turns it into the
+/// linear image everything downstream reads.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Film {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
+    /// One accumulator per pixel, row-major from the top-left
+    /// (`y * width + x`).
     pub pixels: Vec<PixelAccumulator>,
     /// Samples that came back NaN, infinite or beyond [`MAX_SAMPLE_VALUE`]
     /// and were dropped.
@@ -176,13 +185,17 @@ pub struct Film {
 /// Why two films cannot be added.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum FilmMergeError {
+    /// The first film's width and height, then the second's.
     #[error("the films differ in size ({0}×{1} and {2}×{3})")]
     Size(u32, u32, u32, u32),
+    /// Merging would push this pixel's (row-major index) sample count past
+    /// `u32::MAX`.
     #[error("pixel {0} would hold more than {max} samples", max = u32::MAX)]
     CountOverflow(usize),
 }
 
 impl Film {
+    /// An empty film of `width` × `height` pixels.
     pub fn new(width: u32, height: u32) -> Self {
         Self {
             width,
@@ -225,8 +238,13 @@ impl Film {
 /// A linear-radiance image, row-major from the top-left.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Frame {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
+    /// Linear RGB radiance per pixel, row-major from the top-left
+    /// (`y * width + x`): the mean of the pixel's samples, before exposure
+    /// and tone mapping.
     pub pixels: Vec<[f32; 3]>,
     /// Per-pixel standard error of mean luminance; empty when unknown.
     pub noise: Vec<f32>,
@@ -245,8 +263,11 @@ pub enum ToneMap {
 }
 
 impl ToneMap {
+    /// Every tone map, in the order the viewer lists them.
     pub const ALL: [ToneMap; 3] = [ToneMap::Clamp, ToneMap::Reinhard, ToneMap::Filmic];
 
+    /// Maps one linear channel value (after exposure) to [0, 1]; negative
+    /// input is clamped to 0 first.
     pub fn apply(self, x: f64) -> f64 {
         let x = x.max(0.0);
         match self {

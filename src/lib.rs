@@ -11,6 +11,7 @@
 //! and merges the parts' films exactly.
 
 #![forbid(unsafe_code)]
+#![warn(missing_docs)]
 
 pub mod accel;
 pub mod bench;

@@ -13,7 +13,10 @@ use glam::{DVec2, DVec3};
 pub struct Light {
     /// The primitive's id in the scene.
     pub primitive: u32,
+    /// Emitted radiance Le, constant over the surface and over directions.
     pub radiance: Color,
+    /// Whether it emits from both faces; otherwise only towards the side its
+    /// geometric normal points to.
     pub two_sided: bool,
 }
 
@@ -22,10 +25,16 @@ pub struct Light {
 pub struct LightSample {
     /// Unit direction from the reference point to the light point.
     pub wi: DVec3,
+    /// Distance from the reference point to `point`.
     pub distance: f64,
+    /// The chosen point on the light, world space.
     pub point: DVec3,
+    /// Conservative absolute error bound of `point`, per axis (shadow rays
+    /// stop short of the light by more than this).
     pub point_error: DVec3,
+    /// Unit outward normal of the light at `point`.
     pub normal: DVec3,
+    /// Radiance the light emits towards the reference point.
     pub radiance: Color,
     /// Solid-angle density, including the probability of choosing this light.
     pub pdf: f64,
@@ -34,11 +43,14 @@ pub struct LightSample {
 /// The surface of an emissive primitive: a shape, or one of the scene's triangles.
 #[derive(Clone, Copy, Debug)]
 pub enum Emitter<'a> {
+    /// A primitive that is not a triangle (sphere, box, quad, revolution).
     Shape(&'a Shape),
+    /// A triangle of the scene, in double precision.
     Triangle(Triangle),
 }
 
 impl Emitter<'_> {
+    /// Surface area (one face: two-sidedness is the light's business).
     pub fn area(&self) -> f64 {
         match self {
             Emitter::Shape(shape) => shape.area(),
@@ -71,12 +83,14 @@ impl Emitter<'_> {
 
 /// Where lights find their surfaces (the scene's geometry).
 pub trait EmitterSource {
+    /// The surface of the primitive with this id (see [`Light::primitive`]).
     fn emitter(&self, primitive: u32) -> Emitter<'_>;
 }
 
 /// All lights with their selection distribution.
 #[derive(Clone, Debug, Default)]
 pub struct Lights {
+    /// Every emissive primitive with a non-black radiance.
     pub lights: Vec<Light>,
     /// Cumulative selection probabilities, last = 1.
     cdf: Vec<f64>,
@@ -84,6 +98,9 @@ pub struct Lights {
     probability: Vec<f64>,
     /// (primitive, light index), sorted by primitive.
     by_primitive: Vec<(u32, u32)>,
+    /// Sum of the lights' powers π · area · luminance(Le) (· 2 if two-sided):
+    /// the normaliser of the selection probabilities, and the luminance of
+    /// the total emitted power (photon flux scale).
     pub total_power: f64,
 }
 
@@ -123,6 +140,7 @@ impl Lights {
         self.lights.len()
     }
 
+    /// Whether the scene has no lights.
     pub fn is_empty(&self) -> bool {
         self.lights.is_empty()
     }

@@ -21,7 +21,9 @@ pub const RELATIVE_MSE_EPSILON: f64 = 0.01;
 /// Error of an estimate against a reference.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ErrorMetrics {
+    /// Root-mean-square error, in linear radiance.
     pub rmse: f64,
+    /// Relative MSE with ε = [`RELATIVE_MSE_EPSILON`] (see the module doc).
     pub relative_mse: f64,
     /// Mean signed error per channel (R, G, B).
     pub bias: [f64; 3],

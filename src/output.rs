@@ -7,23 +7,42 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
+/// Why an image could not be written; both name the file.
 #[derive(Debug, thiserror::Error)]
 pub enum OutputError {
+    /// The file name's extension is not one of the formats Prism writes.
     #[error("{path}: unsupported image format (use .png, .bmp, .ppm or .exr)")]
-    UnsupportedFormat { path: PathBuf },
+    UnsupportedFormat {
+        /// The requested image file.
+        path: PathBuf,
+    },
+    /// Creating, writing or renaming the file failed.
     #[error("{path}: cannot write image: {message}")]
-    Write { path: PathBuf, message: String },
+    Write {
+        /// The requested image file.
+        path: PathBuf,
+        /// What failed.
+        message: String,
+    },
 }
 
+/// The image formats Prism writes, chosen by the file's extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ImageFormat {
+    /// 8-bit sRGB PNG, with metadata as text chunks.
     Png,
+    /// 8-bit sRGB BMP.
     Bmp,
+    /// 8-bit sRGB PPM.
     Ppm,
+    /// Linear 32-bit float OpenEXR (exposure applied, no tone mapping),
+    /// with metadata as string attributes.
     Exr,
 }
 
 impl ImageFormat {
+    /// The format named by `path`'s extension (case-insensitive); `None` for
+    /// any other extension or none.
     pub fn from_path(path: &Path) -> Option<Self> {
         let extension = path.extension()?.to_str()?.to_ascii_lowercase();
         match extension.as_str() {

@@ -14,6 +14,8 @@ use serde::{Deserialize, Serialize};
 use std::time::Duration;
 pub use validate::{Setting, SettingError, SettingsPatch};
 
+/// Which light-transport algorithm renders the image; the names are the
+/// scene file's and command line's spellings.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Deserialize, Serialize)]
 pub enum IntegratorKind {
     /// Path tracing with next-event estimation and MIS.
@@ -29,8 +31,11 @@ pub enum IntegratorKind {
 }
 
 impl IntegratorKind {
+    /// Every integrator, in the order menus list them.
     pub const ALL: [IntegratorKind; 3] = [IntegratorKind::PathTracing, IntegratorKind::BsdfOnly, IntegratorKind::Sppm];
 
+    /// The name in scene files and on the command line (`pt`, `pt-bsdf`,
+    /// `sppm`).
     pub fn name(self) -> &'static str {
         match self {
             IntegratorKind::PathTracing => "pt",
@@ -46,17 +51,31 @@ impl std::fmt::Display for IntegratorKind {
     }
 }
 
+/// Everything that decides which samples a render takes (see the module
+/// doc). Two renders with equal settings of the same scene and camera
+/// produce the same image bit for bit after the same number of passes,
+/// whatever the thread count.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// Samples per pixel (path tracing) or iterations (SPPM); `None` = until stopped.
     pub samples_per_pixel: Option<u32>,
+    /// Stop after this much render time; `None` = no limit. With a sample
+    /// target as well, whichever is reached first ends the render.
     pub time_limit: Option<Duration>,
+    /// Most bounces per path: scattering events for path tracing; specular
+    /// bounces of camera paths and surface hits of photons for SPPM.
     pub max_depth: u32,
+    /// The light-transport algorithm.
     pub integrator: IntegratorKind,
+    /// The sample generator.
     pub sampler: SamplerKind,
+    /// Seed of every sample stream: different seeds give independent images.
     pub seed: u64,
+    /// SPPM's own settings (photons, radius), read only by SPPM.
     pub sppm: SppmSettings,
     /// Adaptive sampling: a pixel stops receiving samples once its relative
     /// standard error falls below this (see `integrator::pass::ADAPTIVE_*`);
@@ -71,7 +90,9 @@ pub struct RenderSettings {
 /// keeps its place whatever the resolution (previews, resolution scale).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Region {
+    /// Top-left corner (x, y), each in [0, 1].
     pub min: [f64; 2],
+    /// Bottom-right corner (x, y), each in [0, 1]; greater than `min`.
     pub max: [f64; 2],
 }
 
@@ -101,9 +122,13 @@ impl Region {
 /// A half-open rectangle of pixels: columns `x0..x1`, rows `y0..y1`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PixelRect {
+    /// First column.
     pub x0: u32,
+    /// First row (0 at the top).
     pub y0: u32,
+    /// One past the last column.
     pub x1: u32,
+    /// One past the last row.
     pub y1: u32,
 }
 
@@ -118,11 +143,13 @@ impl PixelRect {
         }
     }
 
+    /// Whether pixel (x, y) lies in the rectangle.
     #[inline]
     pub fn contains(&self, x: u32, y: u32) -> bool {
         (self.x0..self.x1).contains(&x) && (self.y0..self.y1).contains(&y)
     }
 
+    /// Number of pixels in the rectangle.
     pub fn pixel_count(&self) -> usize {
         (self.x1 - self.x0) as usize * (self.y1 - self.y0) as usize
     }
@@ -147,10 +174,12 @@ impl Default for RenderSettings {
 }
 
 impl RenderSettings {
+    /// Width over height.
     pub fn aspect(&self) -> f64 {
         self.width as f64 / self.height as f64
     }
 
+    /// `width × height`.
     pub fn pixel_count(&self) -> usize {
         self.width as usize * self.height as usize
     }

@@ -8,11 +8,14 @@ use crate::math::Aabb;
 /// An axis-aligned box in `f32`; `EMPTY` is the identity of `union`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bounds32 {
+    /// Lower corner, rounded towards −∞ from the exact bound.
     pub min: [f32; 3],
+    /// Upper corner, rounded towards +∞ from the exact bound.
     pub max: [f32; 3],
 }
 
 impl Bounds32 {
+    /// The box containing nothing (`min = +∞`, `max = −∞`).
     pub const EMPTY: Bounds32 = Bounds32 {
         min: [f32::INFINITY; 3],
         max: [f32::NEG_INFINITY; 3],
@@ -26,6 +29,7 @@ impl Bounds32 {
         }
     }
 
+    /// The smallest box containing both.
     #[inline]
     pub fn union(&self, other: &Bounds32) -> Self {
         Self {
@@ -34,6 +38,7 @@ impl Bounds32 {
         }
     }
 
+    /// The smallest box containing this one and `point`.
     #[inline]
     pub fn include(&self, point: [f32; 3]) -> Self {
         Self {
@@ -57,10 +62,12 @@ impl Bounds32 {
         x * y + y * z + z * x
     }
 
+    /// Whether `other` lies entirely inside this box (faces may touch).
     pub fn contains(&self, other: &Bounds32) -> bool {
         (0..3).all(|axis| self.min[axis] <= other.min[axis] && other.max[axis] <= self.max[axis])
     }
 
+    /// The same box in double precision (exactly: every `f32` is an `f64`).
     pub fn to_aabb(self) -> Aabb {
         Aabb {
             min: glam::DVec3::from_array(self.min.map(f64::from)),

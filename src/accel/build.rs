@@ -37,11 +37,14 @@ pub const MAX_LEAF_SIZE: usize = 4;
 /// A box as two four-lane vectors; lane 3 is zero.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Box4 {
+    /// Lower corner in lanes 0–2 (x, y, z).
     pub lower: f32x4,
+    /// Upper corner in lanes 0–2 (x, y, z).
     pub upper: f32x4,
 }
 
 impl Box4 {
+    /// The box containing nothing; the identity of `union`.
     pub const EMPTY: Box4 = Box4 {
         lower: f32x4::new([f32::INFINITY, f32::INFINITY, f32::INFINITY, 0.0]),
         upper: f32x4::new([f32::NEG_INFINITY, f32::NEG_INFINITY, f32::NEG_INFINITY, 0.0]),
@@ -56,6 +59,7 @@ impl Box4 {
         }
     }
 
+    /// The same box as three-component [`Bounds32`].
     pub fn to_bounds(self) -> Bounds32 {
         let (lower, upper) = (self.lower.to_array(), self.upper.to_array());
         Bounds32 {
@@ -108,6 +112,7 @@ impl Box4 {
 /// One primitive as the builder sees it.
 #[derive(Clone, Copy, Debug)]
 pub struct BuildItem {
+    /// The primitive's outward-rounded bounds.
     pub bounds: Box4,
     /// Index into the caller's primitives.
     pub index: u32,
@@ -116,6 +121,7 @@ pub struct BuildItem {
 }
 
 impl BuildItem {
+    /// An item for primitive `index` of leaf kind `kind`, with bounds `bounds`.
     pub fn new(bounds: Bounds32, index: u32, kind: u8) -> Self {
         Self {
             bounds: Box4::from_bounds(&bounds),
@@ -135,16 +141,29 @@ impl BuildItem {
 /// its parent).
 #[derive(Clone, Copy, Debug)]
 pub struct BinaryNode {
+    /// Bounds of everything below the node.
     pub bounds: Box4,
+    /// A leaf range or the link to the children.
     pub content: BinaryContent,
 }
 
+/// What a [`BinaryNode`] is: a leaf or an interior node.
 #[derive(Clone, Copy, Debug)]
 pub enum BinaryContent {
     /// Items `first .. first + count` of the reordered item list, all of one kind.
-    Leaf { first: u32, count: u32, kind: u8 },
+    Leaf {
+        /// Index of the leaf's first item in the reordered list.
+        first: u32,
+        /// Number of items, 1 to the kind's maximum leaf size.
+        count: u32,
+        /// The items' kind (see [`BuildItem::kind`]).
+        kind: u8,
+    },
     /// The left child is the next node; the right child is at `right`.
-    Interior { right: u32 },
+    Interior {
+        /// Index of the right child in the node list.
+        right: u32,
+    },
 }
 
 /// Builds the binary tree over `items`, reordering them into leaf order;

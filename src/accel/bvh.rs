@@ -88,19 +88,25 @@ impl Node {
 /// A leaf: primitives `first .. first + count` of one kind.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Leaf {
+    /// Kind of every primitive in the leaf (below [`KIND_COUNT`]).
     pub kind: u8,
+    /// Index of the first primitive within its kind's leaf-ordered list.
     pub first: u32,
+    /// Number of primitives, 1 to [`MAX_LEAF_SIZE`].
     pub count: u32,
 }
 
 /// A primitive to build over: its exact bounds and its kind.
 #[derive(Clone, Copy, Debug)]
 pub struct BuildPrimitive {
+    /// Exact bounds; rounded outward to `f32` for the tree.
     pub bounds: Aabb,
     /// Below [`KIND_COUNT`].
     pub kind: u8,
 }
 
+/// The four-wide BVH: nodes in an array (root at 0), built once per scene
+/// and read only afterwards, so traversal needs no locks.
 #[derive(Clone, Debug, Default)]
 pub struct Bvh {
     nodes: Vec<Node>,
@@ -171,10 +177,12 @@ impl Bvh {
         )
     }
 
+    /// Number of four-wide nodes (interior nodes only; leaves are references).
     pub fn node_count(&self) -> usize {
         self.nodes.len()
     }
 
+    /// Number of leaves.
     pub fn leaf_count(&self) -> usize {
         self.leaf_count
     }
@@ -405,6 +413,9 @@ pub struct TraversalRay {
 }
 
 impl TraversalRay {
+    /// Prepares `ray` for the four-lane box tests: the
+    /// outward-bracketed origin, the reciprocal direction and the entry and
+    /// exit plane of each axis, by the sign of the direction.
     #[inline(always)]
     pub fn new(ray: &Ray) -> Self {
         let reciprocal: [f32; 3] = std::array::from_fn(|axis| (1.0 / ray.direction[axis]) as f32);

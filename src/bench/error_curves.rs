@@ -25,13 +25,19 @@ use std::time::Duration;
 /// One way of rendering that the curves compare.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Configuration {
+    /// Label in tables and plot legends, e.g. `pt/sobol+adaptive0.01`.
     pub name: String,
+    /// The integrator to render with.
     pub integrator: IntegratorKind,
+    /// The sample generator.
     pub sampler: SamplerKind,
+    /// Relative-error threshold of adaptive sampling; `None` renders every
+    /// pixel every pass.
     pub adaptive_threshold: Option<f64>,
 }
 
 impl Configuration {
+    /// A configuration named after its choices.
     pub fn new(integrator: IntegratorKind, sampler: SamplerKind, adaptive_threshold: Option<f64>) -> Self {
         let adaptive = adaptive_threshold.map_or(String::new(), |t| format!("+adaptive{t}"));
         Self {
@@ -91,13 +97,17 @@ pub fn time_ladder(first_seconds: f64, last_seconds: f64) -> Vec<f64> {
 /// The error of one configuration at one rung of the ladder.
 #[derive(Clone, Debug)]
 pub struct CurvePoint {
+    /// The rung of the ladder, in seconds of render time.
     pub target_seconds: f64,
     /// Render time actually spent: the first pass boundary past the target.
     pub elapsed_seconds: f64,
+    /// Passes completed: samples per pixel, or SPPM iterations.
     pub passes: u32,
     /// The integrator's status then (e.g. the share of pixels adaptive sampling keeps active).
     pub status: String,
+    /// Error of the estimate against the reference.
     pub metrics: ErrorMetrics,
+    /// Samples dropped as NaN or infinite so far (should be 0).
     pub rejected_samples: u64,
 }
 
@@ -218,9 +228,13 @@ pub fn make_reference(loaded: &LoadedScene, settings: &RenderSettings, path: &Pa
 
 /// Results of every configuration on one scene.
 pub struct SceneCurves {
+    /// The scene's name, for file names and titles.
     pub scene: String,
+    /// Image width in pixels (the reference's).
     pub width: u32,
+    /// Image height in pixels (the reference's).
     pub height: u32,
+    /// Each configuration with its points, in the order measured.
     pub curves: Vec<(Configuration, Vec<CurvePoint>)>,
 }
 

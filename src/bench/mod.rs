@@ -28,14 +28,30 @@ use std::path::Path;
 /// Why a benchmark could not run or write its results.
 #[derive(Debug, thiserror::Error)]
 pub enum BenchError {
+    /// Reading or writing a file failed.
     #[error("{path}: {source}")]
-    Io { path: String, source: std::io::Error },
+    Io {
+        /// The file.
+        path: String,
+        /// What the operating system reported.
+        source: std::io::Error,
+    },
+    /// A benchmark scene did not load.
     #[error(transparent)]
     Scene(#[from] crate::scene::SceneError),
+    /// The reference image could not be made or read, or its size differs
+    /// from the estimate's.
     #[error("reference image: {0}")]
     Reference(String),
+    /// Drawing a plot failed.
     #[error("plot {path}: {message}")]
-    Plot { path: String, message: String },
+    Plot {
+        /// The PNG file being drawn.
+        path: String,
+        /// The plotting library's message.
+        message: String,
+    },
+    /// The benchmark's thread pool could not be created.
     #[error("cannot start worker threads: {0}")]
     Threads(#[from] rayon::ThreadPoolBuildError),
 }
@@ -63,12 +79,17 @@ pub fn machine_note() -> String {
 
 /// A CSV table: `#` comment lines, a header, rows; written atomically.
 pub struct Csv {
+    /// Lines written before the header, each prefixed with `# ` (settings,
+    /// machine load).
     pub comments: Vec<String>,
+    /// Column names.
     pub header: Vec<&'static str>,
+    /// Rows of already formatted cells, one per header column.
     pub rows: Vec<Vec<String>>,
 }
 
 impl Csv {
+    /// An empty table with the given columns.
     pub fn new(header: Vec<&'static str>) -> Self {
         Self {
             comments: Vec::new(),
@@ -77,6 +98,8 @@ impl Csv {
         }
     }
 
+    /// The table as CSV text: comments, header, rows, each line ending in `\n`.
+    /// Cells are not quoted, so they must not contain commas.
     pub fn to_text(&self) -> String {
         let mut text = String::new();
         for comment in &self.comments {
@@ -93,6 +116,7 @@ impl Csv {
         text
     }
 
+    /// Writes the table to `path` atomically (see [`write_atomically`]).
     pub fn write(&self, path: &Path) -> Result<(), BenchError> {
         write_atomically(path, self.to_text().as_bytes())
     }

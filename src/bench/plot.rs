@@ -16,7 +16,10 @@ pub const ENABLED: bool = cfg!(feature = "plots");
 /// One line: a name for the legend and its (x, y) points.
 #[derive(Clone, Debug, Default)]
 pub struct Series {
+    /// Legend entry.
     pub name: String,
+    /// Points in drawing order; on a log axis, non-positive values are not
+    /// drawable.
     pub points: Vec<(f64, f64)>,
     /// Drawn thin, grey and without markers: for guide lines such as n log n.
     pub guide: bool,
@@ -25,11 +28,17 @@ pub struct Series {
 /// A titled plot of several series.
 #[derive(Clone, Debug, Default)]
 pub struct LinePlot {
+    /// Heading drawn above the plot.
     pub title: String,
+    /// Caption of the x axis (with units).
     pub x_label: String,
+    /// Caption of the y axis (with units).
     pub y_label: String,
+    /// Logarithmic x axis.
     pub log_x: bool,
+    /// Logarithmic y axis.
     pub log_y: bool,
+    /// The lines drawn, legend in this order.
     pub series: Vec<Series>,
 }
 

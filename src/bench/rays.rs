@@ -115,24 +115,36 @@ pub fn incoherent_rays(scene: &Scene, count: usize) -> Vec<Ray> {
 /// One measured combination.
 #[derive(Clone, Debug)]
 pub struct RayRow {
+    /// Mesh name (`bunny`, `bunny-x16`, `bunny-x256`).
     pub mesh: String,
+    /// Triangles in the mesh.
     pub triangles: usize,
+    /// Which ray set: `primary` or `incoherent`.
     pub rays: String,
+    /// `closest` (nearest hit) or `occlusion` (any hit).
     pub query: &'static str,
+    /// Worker threads (1 or 2).
     pub threads: usize,
+    /// Millions of rays per second of wall time, best of the repetitions.
     pub mrays_per_second: f64,
+    /// Share of the rays that hit something, 0 to 1.
     pub hit_fraction: f64,
 }
 
 /// Build cost and size of one mesh's acceleration structure.
 #[derive(Clone, Debug)]
 pub struct BuildRow {
+    /// Mesh name.
     pub mesh: String,
+    /// Triangles in the mesh.
     pub triangles: usize,
     /// Best of a few single-threaded builds of the BVH over the triangles' boxes.
     pub build_ms_one_thread: f64,
+    /// As `build_ms_one_thread`, on two threads.
     pub build_ms_two_threads: f64,
+    /// Four-wide nodes of the BVH.
     pub nodes: usize,
+    /// Leaves of the BVH.
     pub leaves: usize,
     /// Nodes plus the triangles' leaf data, per triangle.
     pub bytes_per_triangle: f64,

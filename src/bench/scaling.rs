@@ -74,16 +74,22 @@ pub fn orient_outward(mesh: &mut Mesh, inside: DVec3) {
 /// One row of the BVH measurement.
 #[derive(Clone, Debug)]
 pub struct BvhRow {
+    /// Triangles in the tessellated sphere.
     pub triangles: usize,
+    /// Four-wide nodes of its BVH.
     pub nodes: usize,
     /// Mean of repeated single-threaded builds, in thread CPU time where
     /// known (else wall time), which other load barely disturbs.
     pub build_seconds: f64,
+    /// Wall time of the same builds, mean per build.
     pub build_wall_seconds: f64,
+    /// Probe rays traced.
     pub rays: u64,
     /// Single-threaded nearest-hit cost, CPU time where known.
     pub ns_per_ray: f64,
+    /// As `ns_per_ray`, in wall time.
     pub wall_ns_per_ray: f64,
+    /// Share of the probe rays that hit the sphere, 0 to 1 (about 0.78).
     pub hit_fraction: f64,
 }
 
@@ -157,11 +163,17 @@ fn count_hits(scene: &Scene, rays: &[Ray]) -> u64 {
 /// One row of the render-time measurement.
 #[derive(Clone, Debug)]
 pub struct RenderRow {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels (from the width and the scene's aspect).
     pub height: u32,
+    /// Worker threads.
     pub threads: usize,
+    /// Passes rendered (samples per pixel).
     pub passes: u32,
+    /// Wall time of the whole render, in seconds.
     pub seconds: f64,
+    /// Wall nanoseconds per pixel sample: `seconds / (passes · pixels)`.
     pub ns_per_sample: f64,
 }
 

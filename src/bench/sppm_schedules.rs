@@ -21,8 +21,11 @@ use std::sync::atomic::AtomicBool;
 /// The error of one schedule after some iterations.
 #[derive(Clone, Debug)]
 pub struct ScheduleRow {
+    /// Which radius schedule rendered this row.
     pub schedule: RadiusSchedule,
+    /// SPPM iterations (photon passes) completed.
     pub iterations: u32,
+    /// Error of the image after `iterations` against the reference.
     pub metrics: ErrorMetrics,
     /// Mean gather radius of the latest iteration, in scene units.
     pub mean_radius: f64,

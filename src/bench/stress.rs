@@ -40,8 +40,11 @@ pub const SELF_HIT_FRACTION: f64 = 1e-6;
 /// How hard to push.
 #[derive(Clone, Debug)]
 pub struct StressOptions {
+    /// Image width of the NaN/inf renders, in pixels.
     pub width: u32,
+    /// Image height of the NaN/inf renders, in pixels.
     pub height: u32,
+    /// Passes rendered per integrator.
     pub passes: u32,
     /// Probe rays per scene (self-intersections) and per mesh (leaks).
     pub rays: u64,
@@ -54,9 +57,13 @@ pub struct StressOptions {
 /// One count: in `scene`, `failures` of `tested` did what must not happen.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StressRow {
+    /// The stress scene (or mesh) tested.
     pub scene: String,
+    /// What was counted, e.g. `self-intersections`.
     pub check: String,
+    /// Samples or probe rays tested.
     pub tested: u64,
+    /// How many of them failed; anything but 0 is a defect.
     pub failures: u64,
 }
 
@@ -76,11 +83,14 @@ macro_rules! stress_scene_file {
 /// each axis).
 #[derive(Clone, Copy, Debug)]
 pub struct StressScene {
+    /// Short name, for tables.
     pub name: &'static str,
     /// Path from the crate root; names the scene in errors.
     pub file: &'static str,
     text: &'static str,
+    /// Factor applied to every length of the scene.
     pub scale: f64,
+    /// Distance the scaled scene is moved along each axis.
     pub offset: f64,
 }
 

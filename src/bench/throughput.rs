@@ -14,12 +14,19 @@ use std::time::Duration;
 /// One scene, integrator and thread count.
 #[derive(Clone, Debug)]
 pub struct ThroughputRow {
+    /// The scene's name.
     pub scene: String,
+    /// Path tracing, or SPPM for scenes that ask for it.
     pub integrator: IntegratorKind,
+    /// Worker threads.
     pub threads: usize,
+    /// Image width in pixels (the scene's own).
     pub width: u32,
+    /// Image height in pixels (the scene's own).
     pub height: u32,
+    /// Passes completed in the time budget.
     pub passes: u32,
+    /// Render time actually spent, in seconds.
     pub seconds: f64,
     /// Pixel samples (SPPM: camera paths) per second.
     pub samples_per_second: f64,

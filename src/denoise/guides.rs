@@ -18,7 +18,9 @@ use std::sync::OnceLock;
 /// First-hit albedo and normal per pixel, row-major.
 #[derive(Clone, Debug, Default)]
 pub struct Guides {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// Reflectance of the first surface hit; zero where the ray escapes or
     /// meets a light (nothing to demodulate there).

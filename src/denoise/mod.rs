@@ -5,7 +5,7 @@
 //! 2. the radiance is divided by the albedo, so the filter smooths lighting
 //!    and the texture comes back sharp when multiplied in again (SVGF's
 //!    demodulation, Schied et al. 2017);
-//! 3. the edge-avoiding à-trous wavelet filter ([`atrous`]; Dammertz et al.
+//! 3. the edge-avoiding à-trous wavelet filter (`atrous`; Dammertz et al.
 //!    2010), its luminance weight scaled by each pixel's estimated standard
 //!    deviation (from `Frame::noise`, so the filter backs off by itself as
 //!    samples accumulate), or by a fixed fraction of its luminance where the
@@ -51,6 +51,8 @@ impl Default for DenoiseSettings {
 /// Why a frame cannot be denoised.
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]
 pub enum DenoiseError {
+    /// The guides' width and height, then the frame's: the guides were made
+    /// for another image size (or their buffers have the wrong length).
     #[error("the guides are {0}x{1} but the frame is {2}x{3}")]
     SizeMismatch(u32, u32, u32, u32),
 }

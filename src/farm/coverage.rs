@@ -22,6 +22,7 @@ pub struct Missing {
 }
 
 impl Missing {
+    /// Whether no sample is missing.
     pub fn is_empty(&self) -> bool {
         self.samples == 0
     }

@@ -58,6 +58,10 @@ pub struct PendingFilm {
 }
 
 impl PendingFilm {
+    /// Checks that `path` ends in `.film`, names no directory and lies in an
+    /// existing folder, then creates the hidden temporary file beside it
+    /// (renamed onto `path` when the film is saved), so a render never
+    /// starts that could not write its result.
     pub fn create(path: &Path) -> Result<Self, FarmError> {
         if !is_film_path(path) {
             return Err(FarmError::io(path, format!("a film file must end in .{FILM_EXTENSION}")));

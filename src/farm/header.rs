@@ -23,7 +23,9 @@ use std::path::Path;
 pub struct FilmHeader {
     /// The scene file's name, for people (not compared: the hash is).
     pub scene: String,
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// The samples every row should have once all parts are in (the
     /// `--spp` a `--part K/N` split), when known.
@@ -42,8 +44,12 @@ pub struct FilmHeader {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CoverageBlock {
+    /// The first row covered (0 at the top).
     pub first_row: u32,
+    /// Distance between covered rows; 1 for every row from `first_row` on
+    /// (never 0 in a valid file).
     pub row_step: u32,
+    /// The half-open range of sample indices each covered row holds.
     pub samples: [u32; 2],
 }
 
@@ -65,6 +71,7 @@ impl CoverageBlock {
         }
     }
 
+    /// Whether row `y` is one of the block's rows.
     pub fn contains_row(&self, y: u32) -> bool {
         self.rows().contains(y)
     }
@@ -74,6 +81,7 @@ impl CoverageBlock {
         self.samples[1].saturating_sub(self.samples[0])
     }
 
+    /// Whether the block holds no samples.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }

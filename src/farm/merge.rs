@@ -23,9 +23,12 @@ pub struct MergeOptions {
 pub struct Merged {
     /// The merged film's header: the parts' image, their coverage joined.
     pub header: FilmHeader,
+    /// The parts' samples summed, pixel by pixel.
     pub film: Film,
-    /// Samples held and expected, over all pixels.
+    /// Samples held, over all pixels.
     pub samples_held: u64,
+    /// Samples the complete image holds: the planned samples per pixel
+    /// times the pixel count.
     pub samples_expected: u64,
     /// What no part holds (empty unless allowed).
     pub missing: Missing,

@@ -8,7 +8,7 @@
 //! - [`part`]: which share a machine renders: `--part K/N`, `--part auto`
 //!   from Slurm's or Kubernetes' environment, or `--samples A..B`; and the
 //!   renders that cannot be split (time limits, SPPM's per-pixel radius);
-//! - [`file`]: the film file, a versioned binary format holding a part's
+//! - [`file`](mod@file): the film file, a versioned binary format holding a part's
 //!   exact sums with a [`header`] saying what image it belongs to
 //!   ([`content_hash`] of the scene, every setting that changes the image,
 //!   the seed, the samples covered and Prism's version);

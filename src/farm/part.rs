@@ -27,7 +27,12 @@ use std::ops::Range;
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum PartRequest {
     /// Part `part` of `parts` (0-based).
-    Part { part: u32, parts: u32 },
+    Part {
+        /// Which part, `0..parts`.
+        part: u32,
+        /// How many parts the render is split into (at least 1).
+        parts: u32,
+    },
     /// Sample indices (or iterations) `A..B`.
     Samples(Range<u32>),
 }

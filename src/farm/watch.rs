@@ -41,8 +41,10 @@ pub struct FolderWatch {
 pub struct WatchStatus {
     /// Parts merged.
     pub parts: usize,
-    /// Samples merged and expected once every part is in, over all pixels.
+    /// Samples merged so far, over all pixels.
     pub samples_held: u64,
+    /// Samples the image holds once every part is in, over all pixels (0
+    /// before the first part is read).
     pub samples_expected: u64,
     /// What is still missing.
     pub missing: Missing,

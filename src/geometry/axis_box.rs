@@ -5,16 +5,23 @@ use super::hit::{AreaSample, SurfaceHit};
 use crate::math::{Aabb, Ray, gamma};
 use glam::{DVec2, DVec3};
 
+/// A solid axis-aligned box in world space: normals point out of the
+/// box, uv runs 0..1 across each face.
 #[derive(Clone, Copy, Debug)]
 pub struct AxisBox {
+    /// The box's extent in world space.
     pub bounds: Aabb,
 }
 
 impl AxisBox {
+    /// Total area of the six faces.
     pub fn area(&self) -> f64 {
         self.bounds.surface_area()
     }
 
+    /// Nearest hit in `(0, t_max)`: the entry face, or the exit face when the
+    /// ray starts inside. The hit coordinate is snapped onto the face plane,
+    /// so its error bound is zero along that axis.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
         let (axis, t) = self.solve(ray, t_max)?;

@@ -23,9 +23,13 @@ pub struct SurfaceHit {
 /// A point drawn on a shape's surface.
 #[derive(Clone, Copy, Debug)]
 pub struct AreaSample {
+    /// Position on the surface, world space.
     pub point: DVec3,
+    /// Conservative absolute error bound of `point`, per axis (for
+    /// [`crate::math::Ray::spawn`]).
     pub point_error: DVec3,
     /// Unit outward normal at `point`.
     pub normal: DVec3,
+    /// Surface parameterisation at `point`, as [`SurfaceHit::uv`] reports it.
     pub uv: DVec2,
 }

@@ -9,8 +9,11 @@ use std::path::Path;
 /// Shared per-vertex attributes of a mesh; faces index into them.
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
+    /// Vertex positions, world space (the transform is already applied).
     pub positions: Vec<DVec3>,
+    /// Unit vertex normals, world space; empty unless every vertex has one.
     pub normals: Vec<DVec3>,
+    /// Vertex texture coordinates; empty unless every vertex has one.
     pub uvs: Vec<DVec2>,
     /// Per face: position indices; normals and uv use the same indices
     /// (tobj's single-index mode).
@@ -21,6 +24,7 @@ pub struct Mesh {
 /// group uses (`usemtl`).
 #[derive(Clone, Debug)]
 pub struct ObjFile {
+    /// All the file's models merged into one mesh, in world space.
     pub mesh: Mesh,
     /// Per face of `mesh`: an index into `materials`, if its group named one.
     pub face_materials: Vec<Option<usize>>,

@@ -36,15 +36,21 @@ use glam::{DVec2, DVec3};
 /// One intersectable surface.
 #[derive(Clone, Debug)]
 pub enum Shape {
+    /// A sphere (exact, not tessellated).
     Sphere(Sphere),
+    /// A single triangle; meshes become many of these until the scene moves
+    /// them into [`triangles::Triangles`].
     Triangle(Triangle),
+    /// A solid axis-aligned box.
     AxisBox(AxisBox),
+    /// A parallelogram, the usual area light.
     Quad(Quad),
     /// Boxed: it carries its profile and sampling tables.
     Revolution(Box<Revolution>),
 }
 
 impl Shape {
+    /// World-space bounds, for the BVH.
     pub fn bounds(&self) -> Aabb {
         match self {
             Shape::Sphere(s) => s.bounds(),
@@ -55,6 +61,8 @@ impl Shape {
         }
     }
 
+    /// Surface area in square scene units; uniform area sampling has density
+    /// `1 / area()`.
     pub fn area(&self) -> f64 {
         match self {
             Shape::Sphere(s) => s.area(),

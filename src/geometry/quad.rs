@@ -5,16 +5,24 @@ use super::hit::{AreaSample, SurfaceHit};
 use crate::math::{Aabb, Ray, gamma};
 use glam::{DVec2, DVec3};
 
+/// A parallelogram `corner + a·edge_u + b·edge_v`, a, b in [0, 1]. It is
+/// one-sided only for emission (see `normal`); rays hit both sides, and uv
+/// is (a, b).
 #[derive(Clone, Copy, Debug)]
 pub struct Quad {
+    /// The corner where a = b = 0, world space.
     pub corner: DVec3,
+    /// The side along which `a` (and u) grows.
     pub edge_u: DVec3,
+    /// The side along which `b` (and v) grows.
     pub edge_v: DVec3,
     /// Unit normal `edge_u × edge_v`: the emitting side of a quad light.
     pub normal: DVec3,
 }
 
 impl Quad {
+    /// The parallelogram with the given corner and sides, its normal
+    /// `edge_u × edge_v` normalised (so the edges must not be parallel).
     pub fn new(corner: DVec3, edge_u: DVec3, edge_v: DVec3) -> Self {
         Self {
             corner,
@@ -24,6 +32,7 @@ impl Quad {
         }
     }
 
+    /// World-space bounds of the four corners.
     pub fn bounds(&self) -> Aabb {
         Aabb::from_points(&[
             self.corner,
@@ -33,6 +42,7 @@ impl Quad {
         ])
     }
 
+    /// Area `|edge_u × edge_v|`.
     pub fn area(&self) -> f64 {
         self.edge_u.cross(self.edge_v).length()
     }

@@ -8,6 +8,7 @@ use glam::DVec3;
 /// A point chosen on a surface as seen from a reference point.
 #[derive(Clone, Copy, Debug)]
 pub struct ShapeSample {
+    /// The chosen surface point, world space.
     pub point: DVec3,
     /// Conservative absolute error bound of `point`, per axis.
     pub point_error: DVec3,

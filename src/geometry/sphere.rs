@@ -7,13 +7,18 @@ use crate::math::{Aabb, Frame, Ray, gamma, warp};
 use glam::{DVec2, DVec3};
 use std::f64::consts::PI;
 
+/// A sphere in world space; normals point outward, uv is equirectangular
+/// (see [`Sphere::uv_of`]).
 #[derive(Clone, Copy, Debug)]
 pub struct Sphere {
+    /// Centre, world space.
     pub center: DVec3,
+    /// Radius in scene units (positive).
     pub radius: f64,
 }
 
 impl Sphere {
+    /// The axis-aligned cube around the sphere.
     pub fn bounds(&self) -> Aabb {
         Aabb::new(
             self.center - DVec3::splat(self.radius),
@@ -21,6 +26,7 @@ impl Sphere {
         )
     }
 
+    /// Surface area 4πr².
     pub fn area(&self) -> f64 {
         4.0 * PI * self.radius * self.radius
     }

@@ -6,6 +6,7 @@ use glam::{DAffine3, DMat3, DQuat, DVec3};
 /// A rigid-plus-scale placement of an object from its own coordinates into the world.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Transform {
+    /// Object to world: `x ↦ M x + t` with `M = R S` (scale first).
     pub to_world: DAffine3,
 }
 
@@ -27,6 +28,7 @@ impl Transform {
         }
     }
 
+    /// A point from object to world space.
     pub fn point(&self, p: DVec3) -> DVec3 {
         self.to_world.transform_point3(p)
     }
@@ -36,6 +38,7 @@ impl Transform {
         self.to_world.matrix3.inverse().transpose()
     }
 
+    /// Whether this is exactly the identity (nothing to apply).
     pub fn is_identity(&self) -> bool {
         self.to_world == DAffine3::IDENTITY
     }

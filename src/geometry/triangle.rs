@@ -12,15 +12,21 @@ use glam::{DVec2, DVec3};
 /// `triangles.rs`.)
 #[derive(Clone, Copy, Debug)]
 pub struct Triangle {
+    /// Corners in world space; their order defines the face normal
+    /// `(v1 − v0) × (v2 − v0)` (counter-clockwise seen from its side).
     pub vertices: [DVec3; 3],
+    /// Index of the mesh it comes from (for vertex normals and uv).
     pub mesh: u32,
+    /// Index of the face within that mesh.
     pub face: u32,
 }
 
 /// Where on a triangle the ray landed, before shading attributes are looked up.
 #[derive(Clone, Copy, Debug)]
 pub struct TriangleHit {
+    /// Ray parameter of the hit (distance, as ray directions are unit length).
     pub t: f64,
+    /// Barycentric weights of vertices 0, 1 and 2; they sum to 1.
     pub barycentric: [f64; 3],
 }
 
@@ -40,6 +46,8 @@ pub struct TriangleRay {
 }
 
 impl TriangleRay {
+    /// The per-ray permutation and shear of the watertight test (Woop et al.
+    /// 2013, §3): the axis of the direction's largest magnitude becomes z.
     pub fn new(ray: &Ray) -> Self {
         let d = ray.direction;
         let kz = d.abs().max_position();
@@ -117,10 +125,12 @@ impl TriangleRay {
 }
 
 impl Triangle {
+    /// World-space bounds of the three vertices.
     pub fn bounds(&self) -> Aabb {
         Aabb::from_points(&self.vertices)
     }
 
+    /// Area `|(b − a) × (c − a)| / 2`.
     pub fn area(&self) -> f64 {
         let [a, b, c] = self.vertices;
         0.5 * (b - a).cross(c - a).length()

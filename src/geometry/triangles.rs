@@ -22,8 +22,11 @@ use glam::DVec3;
 /// Which face of which mesh a stored triangle is, and its material.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TriangleSource {
+    /// Index of the scene mesh the triangle belongs to.
     pub mesh: u32,
+    /// Index of the face within that mesh (for its normals and uv).
     pub face: u32,
+    /// Index of the triangle's material in the scene's material list.
     pub material: u32,
 }
 
@@ -56,6 +59,7 @@ pub struct Triangles {
 pub struct LeafHit {
     /// Index of the triangle in leaf order.
     pub index: u32,
+    /// Ray parameter and barycentric coordinates of the hit.
     pub hit: TriangleHit,
 }
 
@@ -82,10 +86,12 @@ impl Triangles {
         Self { packed, cold, anchors }
     }
 
+    /// Number of triangles stored.
     pub fn len(&self) -> usize {
         self.packed.len()
     }
 
+    /// Whether no triangle is stored.
     pub fn is_empty(&self) -> bool {
         self.packed.is_empty()
     }
@@ -108,6 +114,7 @@ impl Triangles {
         }
     }
 
+    /// Which mesh, face and material triangle `index` (in leaf order) comes from.
     pub fn source(&self, index: u32) -> TriangleSource {
         let cold = self.cold[index as usize];
         TriangleSource {

@@ -12,6 +12,7 @@ use std::ops::Range;
 /// gets a like mix of cheap and costly parts of the image.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct RowSet {
+    /// The first row sampled (0 at the top).
     pub first: u32,
     /// At least 1.
     pub step: u32,

@@ -26,6 +26,10 @@ pub fn fresnel_dielectric(cos_theta_i: f64, ior: f64) -> f64 {
     0.5 * (r_parallel * r_parallel + r_perpendicular * r_perpendicular)
 }
 
+/// Reflects with probability F (Fresnel) and refracts by Snell's law
+/// otherwise, so the weight is the tint (divided by η² for radiance,
+/// η = n_transmitted / n_incident). `pdf` is the lobe's discrete
+/// probability.
 pub fn sample(ior: f64, tint: Color, wo: DVec3, u_lobe: f64, transport: Transport) -> Option<BsdfSample> {
     if wo.z == 0.0 {
         return None;

@@ -8,10 +8,12 @@ use std::f64::consts::FRAC_1_PI;
 
 use super::BsdfSample;
 
+/// f = albedo / π when `wo` and `wi` lie on the same side, else 0.
 pub fn eval(albedo: Color, wo: DVec3, wi: DVec3) -> Color {
     if wo.z * wi.z <= 0.0 { Color::ZERO } else { albedo * FRAC_1_PI }
 }
 
+/// cos θi / π on `wo`'s side, else 0.
 pub fn pdf(wo: DVec3, wi: DVec3) -> f64 {
     if wo.z * wi.z <= 0.0 {
         0.0
@@ -20,6 +22,8 @@ pub fn pdf(wo: DVec3, wi: DVec3) -> f64 {
     }
 }
 
+/// A cosine-weighted direction on `wo`'s side; the weight is the albedo.
+/// `None` for grazing `wo` (cos θo = 0).
 pub fn sample(albedo: Color, wo: DVec3, u: DVec2) -> Option<BsdfSample> {
     if wo.z == 0.0 {
         return None;

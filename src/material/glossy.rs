@@ -30,6 +30,8 @@ fn lambda(alpha: f64, w: DVec3) -> f64 {
     0.5 * ((1.0 + alpha * alpha * tan2).sqrt() - 1.0)
 }
 
+/// Schlick's approximation of Fresnel reflectance, F0 + (1 − F0)(1 − cos)⁵
+/// (Schlick 1994, "An Inexpensive BRDF Model for Physically-based Rendering").
 fn schlick(f0: Color, cos: f64) -> Color {
     f0 + (Color::ONE - f0) * (1.0 - cos.clamp(0.0, 1.0)).powi(5)
 }
@@ -43,6 +45,12 @@ fn upper(wo: DVec3, wi: DVec3) -> Option<(DVec3, DVec3)> {
     Some((wo * DVec3::new(1.0, 1.0, flip), wi * DVec3::new(1.0, 1.0, flip)))
 }
 
+/// The Cook–Torrance microfacet BRDF F(wo·h) D(h) G₂(wo, wi) / (4 cos θo
+/// cos θi) with the half vector h (Walter et al. 2007), G₂ the
+/// height-correlated Smith term 1 / (1 + Λ(wo) + Λ(wi)) (Heitz 2014,
+/// "Understanding the Masking-Shadowing Function in Microfacet-Based
+/// BRDFs"). Zero unless both directions lie on one side; the back face
+/// mirrors the front.
 pub fn eval(tint: Color, roughness: f64, wo: DVec3, wi: DVec3) -> Color {
     let Some((wo, wi)) = upper(wo, wi) else { return Color::ZERO };
     let a = alpha(roughness);
@@ -51,6 +59,9 @@ pub fn eval(tint: Color, roughness: f64, wo: DVec3, wi: DVec3) -> Color {
     schlick(tint, wo.dot(h)) * (distribution(a, h) * g2 / (4.0 * wo.z * wi.z))
 }
 
+/// Density of [`sample`]: the visible-normal density
+/// D_wo(h) = G₁(wo) max(0, wo·h) D(h) / cos θo (Heitz 2018) times
+/// the reflection Jacobian 1 / (4 wo·h).
 pub fn pdf(roughness: f64, wo: DVec3, wi: DVec3) -> f64 {
     let Some((wo, wi)) = upper(wo, wi) else { return 0.0 };
     let a = alpha(roughness);
@@ -61,6 +72,10 @@ pub fn pdf(roughness: f64, wo: DVec3, wi: DVec3) -> f64 {
     g1 * distribution(a, h) / (4.0 * wo.z)
 }
 
+/// Samples a visible microfacet normal by Heitz's (2018) construction
+/// (stretch to α = 1, sample the projected hemisphere, unstretch) and
+/// reflects `wo` about it. `None` when the reflection falls below the
+/// surface.
 pub fn sample(tint: Color, roughness: f64, wo: DVec3, u: DVec2) -> Option<BsdfSample> {
     if wo.z == 0.0 {
         return None;

@@ -21,48 +21,72 @@ use glam::{DVec2, DVec3};
 /// (photons) from the lights. Refraction scales them differently (Veach 1997, §5.2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Transport {
+    /// Radiance carried from the camera (path tracing, SPPM camera paths).
     Radiance,
+    /// Importance carried from the lights (SPPM photons).
     Importance,
 }
 
 /// Where a BSDF is evaluated, for texture lookups.
 #[derive(Clone, Copy, Debug)]
 pub struct ShadingPoint {
+    /// Surface texture coordinates at the point.
     pub uv: DVec2,
+    /// The point in world space (for solid, 3D textures).
     pub point: DVec3,
 }
 
 /// A direction drawn from a BSDF.
 #[derive(Clone, Copy, Debug)]
 pub struct BsdfSample {
+    /// The sampled incident direction, local shading frame, unit length.
     pub wi: DVec3,
     /// f·|cos θi| / pdf.
     pub weight: Color,
     /// Density per steradian; for specular lobes the discrete probability of the lobe.
     pub pdf: f64,
+    /// Whether `wi` came from a delta lobe (mirror, glass): emission found
+    /// along it gets no MIS weight, as light sampling could not have made it.
     pub specular: bool,
 }
 
+/// A surface's reflectance and emission. Every variant but `Emissive`
+/// scatters; `Mirror` and `Glass` are purely specular.
 #[derive(Clone, Debug)]
 pub enum Material {
+    /// Lambertian reflection (see [`diffuse`]).
     Diffuse {
+        /// Reflectance per channel, in [0, 1] (the loader refuses more).
         albedo: Texture,
     },
+    /// A perfect mirror (see [`mirror`]).
     Mirror {
+        /// Reflectance per channel, non-negative.
         tint: Texture,
     },
+    /// Smooth glass (see [`dielectric`]): Fresnel-weighted reflection and
+    /// refraction.
     Glass {
+        /// Relative index of refraction, inside over outside; the outside is
+        /// the side the shading normal points to.
         ior: f64,
+        /// Colour multiplying both reflection and transmission.
         tint: Color,
     },
+    /// A rough conductor, GGX microfacets (see [`glossy`]).
     Glossy {
+        /// Reflectance at normal incidence (Schlick's F0) per channel,
+        /// non-negative.
         tint: Texture,
+        /// GGX α, clamped to [10⁻³, 1]: 0 is a near-mirror, 1 very rough.
         roughness: f64,
     },
     /// A light: emits `radiance` from its front (outward normal) side, or both
     /// sides when `two_sided`; reflects nothing.
     Emissive {
+        /// Emitted radiance Le, per channel.
         radiance: Color,
+        /// Emit from both faces, not just the front.
         two_sided: bool,
     },
 }
@@ -87,6 +111,7 @@ impl Material {
         }
     }
 
+    /// The emitted radiance if this is a light, whatever the direction.
     pub fn emission(&self) -> Option<Color> {
         match self {
             Material::Emissive { radiance, .. } => Some(*radiance),
@@ -94,6 +119,8 @@ impl Material {
         }
     }
 
+    /// BSDF value f(wo, wi), without the cosine; zero for purely specular
+    /// materials (their delta lobes are reached only by `sample`).
     pub fn eval(&self, wo: DVec3, wi: DVec3, at: &ShadingPoint) -> Color {
         match self {
             Material::Diffuse { albedo } => diffuse::eval(albedo.evaluate(at), wo, wi),
@@ -102,6 +129,8 @@ impl Material {
         }
     }
 
+    /// Solid-angle density with which `sample` draws `wi` given `wo`; zero
+    /// for purely specular materials.
     pub fn pdf(&self, wo: DVec3, wi: DVec3) -> f64 {
         match self {
             Material::Diffuse { .. } => diffuse::pdf(wo, wi),

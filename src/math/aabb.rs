@@ -6,7 +6,9 @@ use glam::DVec3;
 /// An axis-aligned box; `Aabb::EMPTY` is the identity for `union`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
+    /// Lower corner (per-axis minimum); `+∞` on every axis for the empty box.
     pub min: DVec3,
+    /// Upper corner (per-axis maximum); `-∞` on every axis for the empty box.
     pub max: DVec3,
 }
 
@@ -18,11 +20,14 @@ impl Default for Aabb {
 }
 
 impl Aabb {
+    /// The box containing nothing (`min = +∞`, `max = -∞`), the identity of
+    /// `union`.
     pub const EMPTY: Aabb = Aabb {
         min: DVec3::splat(f64::INFINITY),
         max: DVec3::splat(f64::NEG_INFINITY),
     };
 
+    /// The box spanned by two opposite corners, given in any order.
     pub fn new(a: DVec3, b: DVec3) -> Self {
         Self {
             min: a.min(b),
@@ -30,10 +35,12 @@ impl Aabb {
         }
     }
 
+    /// The smallest box containing every point (`EMPTY` for no points).
     pub fn from_points(points: &[DVec3]) -> Self {
         points.iter().fold(Self::EMPTY, |b, &p| b.include(p))
     }
 
+    /// This box grown just enough to contain `p`.
     pub fn include(self, p: DVec3) -> Self {
         Self {
             min: self.min.min(p),
@@ -41,6 +48,7 @@ impl Aabb {
         }
     }
 
+    /// The smallest box containing both boxes.
     pub fn union(self, other: Aabb) -> Self {
         Self {
             min: self.min.min(other.min),
@@ -48,14 +56,19 @@ impl Aabb {
         }
     }
 
+    /// True when some axis has `min > max`, as for `EMPTY`; a box of zero
+    /// width (a point or a flat quad's bounds) is not empty.
     pub fn is_empty(&self) -> bool {
         self.min.x > self.max.x || self.min.y > self.max.y || self.min.z > self.max.z
     }
 
+    /// Side lengths `max - min`; zero (not negative or NaN) for an empty box.
     pub fn extent(&self) -> DVec3 {
         if self.is_empty() { DVec3::ZERO } else { self.max - self.min }
     }
 
+    /// The box's centre; the BVH builder bins primitives by their bounds'
+    /// centroids.
     pub fn centroid(&self) -> DVec3 {
         0.5 * (self.min + self.max)
     }

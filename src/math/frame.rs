@@ -3,10 +3,15 @@
 
 use glam::DVec3;
 
+/// An orthonormal, right-handed basis (`s × t = n`) used as a shading frame:
+/// `to_local` maps world vectors to coordinates where `n` is +z.
 #[derive(Clone, Copy, Debug)]
 pub struct Frame {
+    /// First tangent; the local +x axis.
     pub s: DVec3,
+    /// Second tangent; the local +y axis.
     pub t: DVec3,
+    /// The (shading) normal; the local +z axis, so a local vector's `z` is cos θ.
     pub n: DVec3,
 }
 
@@ -23,10 +28,13 @@ impl Frame {
         Self { s, t, n }
     }
 
+    /// World-space vector in this frame's coordinates (`n` becomes +z). The
+    /// basis is orthonormal, so this is the transpose of `to_world`.
     pub fn to_local(&self, v: DVec3) -> DVec3 {
         DVec3::new(v.dot(self.s), v.dot(self.t), v.dot(self.n))
     }
 
+    /// Local coordinates back to a world-space vector; the inverse of `to_local`.
     pub fn to_world(&self, v: DVec3) -> DVec3 {
         self.s * v.x + self.t * v.y + self.n * v.z
     }

@@ -6,7 +6,10 @@ use glam::DVec3;
 /// A ray `origin + t * direction`, `t > 0`. The direction is unit length.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ray {
+    /// Where the ray starts (world space); for a spawned ray already offset off
+    /// the surface, so intersection tests accept any `t > 0`.
     pub origin: DVec3,
+    /// Unit-length direction, so `t` measures distance in scene units.
     pub direction: DVec3,
 }
 

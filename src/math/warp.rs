@@ -4,7 +4,8 @@
 use glam::{DVec2, DVec3};
 use std::f64::consts::{FRAC_1_PI, PI};
 
-/// Uniform point on the unit disk, Shirley–Chiu concentric map (keeps strata).
+/// Uniform point on the unit disk, Shirley–Chiu concentric map (keeps strata;
+/// Shirley & Chiu 1997, "A Low Distortion Map Between Disk and Square").
 pub fn square_to_concentric_disk(u: DVec2) -> DVec2 {
     let o = 2.0 * u - DVec2::ONE;
     if o.x == 0.0 && o.y == 0.0 {
@@ -38,6 +39,7 @@ pub fn square_to_uniform_sphere(u: DVec2) -> DVec3 {
     DVec3::new(r * phi.cos(), r * phi.sin(), z)
 }
 
+/// Density of `square_to_uniform_sphere`, per steradian: 1 / 4π.
 pub const UNIFORM_SPHERE_PDF: f64 = 1.0 / (4.0 * PI);
 
 /// Uniform direction in the cone of half-angle `acos(cos_theta_max)` around +z.
@@ -54,6 +56,8 @@ pub fn square_to_uniform_cone_angles(u: DVec2, cos_theta_max: f64) -> (f64, f64)
     ((1.0 - u.x) + u.x * cos_theta_max, 2.0 * PI * u.y)
 }
 
+/// Density of `square_to_uniform_cone`, per steradian: one over the cone's
+/// solid angle 2π (1 − cos θmax).
 pub fn uniform_cone_pdf(cos_theta_max: f64) -> f64 {
     1.0 / (2.0 * PI * (1.0 - cos_theta_max))
 }

@@ -81,7 +81,9 @@ pub enum SessionState {
     /// Waiting for a scene.
     #[default]
     Idle,
+    /// Accumulating passes.
     Rendering,
+    /// Paused by the owner; the accumulation is kept and `Resume` continues it.
     Paused,
     /// Stopped by the owner.
     Stopped,
@@ -94,12 +96,15 @@ pub enum SessionState {
 pub struct RenderStats {
     /// Accumulation number: it grows by one on every restart.
     pub generation: u64,
+    /// What the thread is doing.
     pub state: SessionState,
     /// Completed full-resolution passes (samples per pixel, or SPPM iterations).
     pub passes: u32,
+    /// The sample target (passes), if any.
     pub target_passes: Option<u32>,
     /// Render time of this generation, pauses excluded.
     pub elapsed: Duration,
+    /// The time limit, if any.
     pub time_limit: Option<Duration>,
     /// Pixel samples (or SPPM pixel updates) per second of render time.
     pub samples_per_second: f64,
@@ -108,9 +113,11 @@ pub struct RenderStats {
     /// When the pass in flight started (while rendering), so a reader can
     /// show the render time running between passes.
     pub pass_started: Option<Instant>,
+    /// Samples dropped as NaN or infinite in this generation.
     pub rejected_samples: u64,
     /// The camera and settings the render thread is using now.
     pub camera: Option<Camera>,
+    /// The settings the render thread is using now.
     pub settings: RenderSettings,
 }
 
@@ -151,15 +158,20 @@ impl RenderStats {
 /// A published frame and what it was rendered with.
 #[derive(Clone, Debug)]
 pub struct FrameInfo {
+    /// The image: linear radiance at the frame's own (possibly preview)
+    /// resolution.
     pub frame: Arc<Frame>,
     /// The generation (accumulation) the frame belongs to.
     pub generation: u64,
     /// Publication order; grows with every frame.
     pub sequence: u64,
+    /// The camera the frame was rendered with.
     pub camera: Camera,
+    /// The settings the frame was rendered with.
     pub settings: RenderSettings,
     /// Full-resolution passes in the frame (0 for a preview).
     pub passes: u32,
+    /// Render time of the generation when the frame was published.
     pub elapsed: Duration,
     /// The coarse first pass of a generation.
     pub preview: bool,
@@ -180,7 +192,9 @@ pub struct FrameInfo {
 /// restart, before its first pass lands).
 #[derive(Clone, Debug, Default)]
 pub struct Published {
+    /// The latest frame, if any pass has completed.
     pub frame: Option<FrameInfo>,
+    /// Statistics of the current generation.
     pub stats: RenderStats,
 }
 
@@ -199,10 +213,13 @@ pub struct RenderSession {
     thread: Option<JoinHandle<()>>,
 }
 
+/// Why a render session could not start.
 #[derive(Debug, thiserror::Error)]
 pub enum SessionError {
+    /// The render thread could not be spawned.
     #[error("cannot start the render thread: {0}")]
     Spawn(#[from] std::io::Error),
+    /// The pool of render workers could not be created.
     #[error("cannot start the render worker threads: {0}")]
     Pool(#[from] rayon::ThreadPoolBuildError),
 }
@@ -280,10 +297,12 @@ impl RenderSession {
         }
     }
 
+    /// Renders from `camera` from now on (a restart); returns the generation.
     pub fn set_camera(&mut self, camera: Camera) -> u64 {
         self.send(Command::SetCamera(camera))
     }
 
+    /// Renders `scene` from now on (a restart); returns the generation.
     pub fn set_scene(&mut self, scene: Arc<Scene>) -> u64 {
         self.send(Command::SetScene(scene))
     }

@@ -15,11 +15,15 @@ use std::collections::BTreeMap;
 mod texture;
 pub use texture::{ColorDescription, MappingKind, Numbers, TextureDescription, WrapKind};
 
+/// A point, direction or linear RGB colour as written: `[x, y, z]`.
 pub type Vector = [f64; 3];
 
+/// A whole scene file. Keys are checked strictly (`deny_unknown_fields`):
+/// a misspelt key is an error, not ignored.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneDescription {
+    /// The `[camera]` table.
     pub camera: CameraDescription,
     /// The `[render]` table: the same settings, checked the same way, as the
     /// command line's flags.
@@ -28,21 +32,30 @@ pub struct SceneDescription {
     /// Radiance of rays that escape the scene (linear RGB). Default black.
     #[serde(default)]
     pub background: Option<Vector>,
+    /// The `[materials.NAME]` tables, by name; objects refer to them by name.
     #[serde(default)]
     pub materials: BTreeMap<String, MaterialDescription>,
+    /// The `[[objects]]` array, in file order.
     #[serde(default)]
     pub objects: Vec<ObjectDescription>,
 }
 
+/// The `[camera]` table; see [`crate::camera::Camera`] for the meaning of
+/// each value. Lengths are in scene units.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraDescription {
+    /// Eye position.
     pub position: Vector,
+    /// The point looked at (also the orbit centre in the viewer).
     pub look_at: Vector,
+    /// Approximate up direction; default +y.
     #[serde(default = "default_up")]
     pub up: Vector,
+    /// Vertical field of view in degrees; default 40.
     #[serde(default = "default_fov")]
     pub fov_y_degrees: f64,
+    /// Lens radius; 0 (the default) is a pinhole.
     #[serde(default)]
     pub aperture_radius: f64,
     /// Distance to the plane in focus; default the distance to `look_at`.
@@ -60,28 +73,43 @@ fn default_fov() -> f64 {
     40.0
 }
 
+/// A `[materials.NAME]` table, tagged by its `type`; see
+/// [`crate::material::Material`] for each model.
 #[derive(Debug, Deserialize)]
 #[serde(rename_all = "lowercase", deny_unknown_fields)]
 pub enum MaterialDescription {
+    /// Lambertian reflection.
     Diffuse {
+        /// Reflectance in [0, 1], a colour or texture.
         albedo: ColorDescription,
     },
+    /// A perfect mirror.
     Mirror {
+        /// Reflectance, a colour or texture; default white.
         #[serde(default = "white_texture")]
         tint: ColorDescription,
     },
+    /// Smooth glass.
     Glass {
+        /// Index of refraction inside over outside (positive); default 1.5.
         #[serde(default = "default_ior")]
         ior: f64,
+        /// Colour multiplying reflection and transmission; default white.
         #[serde(default = "white")]
         tint: Vector,
     },
+    /// A rough conductor (GGX).
     Glossy {
+        /// Reflectance at normal incidence, a colour or texture.
         tint: ColorDescription,
+        /// GGX α in [0, 1].
         roughness: f64,
     },
+    /// A light.
     Emissive {
+        /// Emitted radiance, linear RGB.
         radiance: Vector,
+        /// Emit from both faces; default false (front face only).
         #[serde(default)]
         two_sided: bool,
     },
@@ -103,50 +131,80 @@ fn default_ior() -> f64 {
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TransformDescription {
+    /// Translation; default none.
     #[serde(default)]
     pub translate: Option<Vector>,
+    /// Euler angles in degrees, applied about x, then y, then z; default
+    /// none.
     #[serde(default)]
     pub rotate_degrees: Option<Vector>,
+    /// Scale factor(s), non-zero; default 1.
     #[serde(default)]
     pub scale: Option<Scale>,
 }
 
+/// A `scale` value: one factor, or one per axis.
 #[derive(Debug, Deserialize, Clone, Copy)]
 #[serde(untagged)]
 pub enum Scale {
+    /// The same factor on every axis.
     Uniform(f64),
+    /// Factors for x, y and z.
     PerAxis(Vector),
 }
 
+/// One `[[objects]]` entry, tagged by its `type`. Coordinates are world
+/// space, except a mesh's and a revolution's, which their `transform`
+/// places.
 #[derive(Debug, Deserialize)]
 #[serde(rename_all = "lowercase", deny_unknown_fields)]
 pub enum ObjectDescription {
+    /// A sphere.
     Sphere {
+        /// Centre.
         center: Vector,
+        /// Radius, positive.
         radius: f64,
+        /// The material's name.
         material: String,
     },
+    /// A solid axis-aligned box.
     Box {
+        /// The corner of least coordinates.
         min: Vector,
+        /// The opposite corner; greater than `min` on every axis.
         max: Vector,
+        /// The material's name.
         material: String,
     },
+    /// A parallelogram `corner + a·edge_u + b·edge_v`, a, b in [0, 1]; its
+    /// normal (the side a one-sided light emits to) is `edge_u × edge_v`.
     Quad {
+        /// The corner where a = b = 0.
         corner: Vector,
+        /// One side; u runs along it.
         edge_u: Vector,
+        /// The other side; v runs along it. Not parallel to `edge_u`.
         edge_v: Vector,
+        /// The material's name.
         material: String,
     },
+    /// A single triangle.
     Triangle {
+        /// Its corners; counter-clockwise seen from the front.
         vertices: [Vector; 3],
+        /// The material's name.
         material: String,
     },
+    /// A triangle mesh from a Wavefront OBJ file.
     Mesh {
+        /// The OBJ file, relative to the scene file's folder.
         file: String,
         /// The scene's material for every face; if omitted, the faces take
         /// the materials of the OBJ file's `.mtl` library.
         #[serde(default)]
         material: Option<String>,
+        /// Placement of the mesh (applied to its vertices when loaded).
         #[serde(default)]
         transform: TransformDescription,
     },
@@ -162,7 +220,9 @@ pub enum ObjectDescription {
         /// Close the ends with flat discs.
         #[serde(default)]
         caps: bool,
+        /// The material's name.
         material: String,
+        /// Placement of the swept surface.
         #[serde(default)]
         transform: TransformDescription,
     },

@@ -23,7 +23,9 @@ use toml::de::{DeTable, DeValue, Deserializer};
 /// One step of a field path: a table key or an array index.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Segment {
+    /// A table key, as written (unquoted).
     Key(String),
+    /// A 0-based array index.
     Index(usize),
 }
 
@@ -52,10 +54,12 @@ impl FieldPath {
         path
     }
 
+    /// Whether this is the document itself (no segments).
     pub fn is_root(&self) -> bool {
         self.0.is_empty()
     }
 
+    /// The steps from the document's root, outermost first.
     pub fn segments(&self) -> &[Segment] {
         &self.0
     }

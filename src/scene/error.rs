@@ -9,7 +9,9 @@ use std::path::PathBuf;
 /// characters, as editors do).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Location {
+    /// Line, from 1.
     pub line: usize,
+    /// Column in characters, from 1.
     pub column: usize,
 }
 
@@ -30,16 +32,23 @@ impl Location {
     }
 }
 
+/// A scene that could not be read, parsed, checked or built. It displays
+/// as `file:line:column: field: message`, leaving out what is unknown.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SceneError {
+    /// The scene file, as named to the loader; problems in files it refers
+    /// to (meshes, images) are reported at the field that names them.
     pub file: PathBuf,
+    /// Where in the file, when known.
     pub location: Option<Location>,
     /// Full path of the offending key, e.g. `objects[3].radius`.
     pub field: Option<String>,
+    /// What is wrong, for people.
     pub message: String,
 }
 
 impl SceneError {
+    /// An error in `file`, at `location`, about `field`.
     pub fn new(file: impl Into<PathBuf>, location: Option<Location>, field: Option<String>, message: impl Into<String>) -> Self {
         Self {
             file: file.into(),

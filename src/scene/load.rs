@@ -39,8 +39,11 @@ pub const COORDINATE_LIMIT: f64 = 1e12;
 /// A scene ready to render, with the camera and settings its file asked for.
 #[derive(Debug)]
 pub struct LoadedScene {
+    /// The built scene, ready to render.
     pub scene: Scene,
+    /// The camera of the file's `[camera]` table.
     pub camera: Camera,
+    /// Default settings with the file's `[render]` table applied.
     pub settings: RenderSettings,
     /// The file it came from; `None` for the embedded default scene.
     pub path: Option<PathBuf>,

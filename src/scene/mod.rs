@@ -32,14 +32,18 @@ pub const DEFAULT_SCENE: &str = include_str!("../../scenes/cornell.toml");
 /// A shape with its material.
 #[derive(Clone, Debug)]
 pub struct Primitive {
+    /// What it is and where.
     pub shape: Shape,
+    /// Index into the scene's `materials`.
     pub material: u32,
 }
 
 /// A hit and which primitive it belongs to.
 #[derive(Clone, Copy, Debug)]
 pub struct Intersection {
+    /// Where the ray met the surface.
     pub hit: SurfaceHit,
+    /// The primitive it belongs to (numbering as in [`Scene`]).
     pub primitive: u32,
 }
 
@@ -55,8 +59,12 @@ const SHAPE_LEAF: u8 = 1;
 pub struct Scene {
     shapes: Vec<Primitive>,
     triangles: Triangles,
+    /// The meshes triangles come from (for shading normals and uv), with
+    /// positions rounded to the stored form.
     pub meshes: Vec<Mesh>,
+    /// Every material; primitives refer to them by index.
     pub materials: Vec<Material>,
+    /// The emissive primitives and how to choose among them.
     pub lights: Lights,
     /// Radiance of rays that leave the scene.
     pub background: Color,
@@ -147,6 +155,7 @@ impl Scene {
         Self::new(primitives, vec![mesh], materials, Color::ZERO)
     }
 
+    /// Bounds of everything in the scene (rounded outward to `f32`).
     pub fn bounds(&self) -> Aabb {
         self.bvh.bounds()
     }
@@ -169,6 +178,7 @@ impl Scene {
         }
     }
 
+    /// The material of a primitive.
     pub fn material_of(&self, primitive: u32) -> &Material {
         &self.materials[self.material_index(primitive) as usize]
     }
@@ -273,6 +283,7 @@ impl Scene {
         found
     }
 
+    /// The acceleration structure, for statistics and benchmarks.
     pub fn bvh(&self) -> &Bvh {
         &self.bvh
     }

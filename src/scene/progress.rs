@@ -12,9 +12,17 @@ pub enum LoadStage {
     /// Reading and parsing the scene file.
     Parsing,
     /// Building objects (reading meshes); `done` of `total` so far.
-    Objects { done: usize, total: usize },
+    Objects {
+        /// Objects built so far.
+        done: usize,
+        /// Objects in the scene file.
+        total: usize,
+    },
     /// Building the BVH over this many primitives.
-    Bvh { primitives: usize },
+    Bvh {
+        /// Primitives (shapes and triangles) the BVH is built over.
+        primitives: usize,
+    },
 }
 
 impl std::fmt::Display for LoadStage {

@@ -55,20 +55,37 @@ pub const SPPM_BYTES_PER_PIXEL: u64 = 640;
 /// command line (or both: the command line wins).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Setting {
+    /// Image width in pixels, 1 to [`MAX_IMAGE_SIDE`].
     Width,
+    /// Image height in pixels, 1 to [`MAX_IMAGE_SIDE`].
     Height,
+    /// Samples per pixel (SPPM: iterations), at least 1.
     SamplesPerPixel,
+    /// Render-time limit in seconds (command line only).
     TimeLimit,
+    /// Most bounces per path, 1 to [`MAX_DEPTH`].
     MaxDepth,
+    /// The light-transport algorithm.
     Integrator,
+    /// The sample generator.
     Sampler,
+    /// The seed of every sample stream.
     Seed,
+    /// SPPM photons per iteration, at least 1.
     PhotonsPerIteration,
+    /// SPPM's initial gather radius in scene units, within [`RADIUS_RANGE`].
     InitialRadius,
+    /// SPPM's α, strictly between 0 and 1.
     Alpha,
+    /// SPPM's radius schedule.
     RadiusSchedule,
+    /// Relative standard error at which a pixel stops taking samples;
+    /// positive.
     AdaptiveThreshold,
+    /// Worker threads, 1 to [`MAX_THREADS`] (command line only).
     Threads,
+    /// Exposure in stops, within ±[`MAX_EXPOSURE_STOPS`] (command line only;
+    /// display and output, not sampling).
     Exposure,
 }
 
@@ -117,7 +134,9 @@ impl Setting {
 /// A value outside its documented range.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SettingError {
+    /// Which setting was refused.
     pub setting: Setting,
+    /// What is wrong with its value, with the value found.
     pub message: String,
 }
 
@@ -144,15 +163,26 @@ impl std::error::Error for SettingError {}
 #[derive(Clone, Debug, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SettingsPatch {
+    /// Image width in pixels (`--width`).
     pub width: Option<u32>,
+    /// Image height in pixels (`--height`).
     pub height: Option<u32>,
+    /// Samples per pixel, or SPPM iterations (`--spp`).
     pub spp: Option<u32>,
+    /// Most bounces per path (`--max-depth`).
     pub max_depth: Option<u32>,
+    /// `pt`, `pt-bsdf` or `sppm` (`--integrator`).
     pub integrator: Option<IntegratorKind>,
+    /// `sobol` or `random` (`--sampler`).
     pub sampler: Option<SamplerKind>,
+    /// Seed of the sample streams (`--seed`).
     pub seed: Option<u64>,
+    /// SPPM photons per iteration (`--photons`).
     pub photons_per_iteration: Option<u32>,
+    /// SPPM's initial gather radius in scene units (`--radius`); unset picks
+    /// it from the pixel footprint.
     pub initial_radius: Option<f64>,
+    /// SPPM's α, the share of new photons kept per iteration (`--alpha`).
     pub alpha: Option<f64>,
     /// SPPM's radius schedule: "per-pixel" (default) or "global" (farm renders).
     pub radius_schedule: Option<RadiusSchedule>,

@@ -30,6 +30,7 @@ pub const TEXTURE_OPTIONS: TextureOptions = TextureOptions {
 /// The denoised preview.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum DenoiseMode {
+    /// The raw render only (the default).
     #[default]
     Off,
     /// The image area shows the denoised frame.
@@ -41,6 +42,7 @@ pub enum DenoiseMode {
 /// The A/B comparison with a reference image.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum CompareMode {
+    /// The render only (the default).
     #[default]
     Off,
     /// Show the reference instead of the render.

@@ -72,13 +72,18 @@ impl Default for ViewerStart {
     }
 }
 
+/// Why the viewer could not start; each message says how to render
+/// without a window instead.
 #[derive(Debug, thiserror::Error)]
 pub enum ViewerError {
     #[error(
         "no display: neither DISPLAY nor WAYLAND_DISPLAY is set, so the viewer cannot open a window.\n\
          To render without a window use `prism render [SCENE] --output image.png`."
     )]
+    /// No window system is reachable (neither `DISPLAY` nor
+    /// `WAYLAND_DISPLAY` is set).
     NoDisplay,
+    /// The window system refused the window (eframe's message).
     #[error("cannot open the viewer window: {0}\nTo render without a window use `prism render [SCENE] --output image.png`.")]
     Window(String),
 }

@@ -37,6 +37,7 @@ pub struct PathIntegrator {
 }
 
 impl PathIntegrator {
+    /// A path-tracing render of the whole image: every row, samples from 0.
     pub fn new(settings: &RenderSettings) -> Self {
         Self::with_share(settings, &Share::whole(settings.samples_per_pixel.unwrap_or(0)))
     }

@@ -1,6 +1,6 @@
 //! Iterative path tracing (Kajiya 1986) with next-event estimation and
 //! multiple importance sampling by the power heuristic (Veach 1997, ch. 9),
-//! and Russian roulette; or, in BSDF-only mode, the original's estimator
+//! and Russian roulette (Arvo & Kirk 1990); or, in BSDF-only mode, the original's estimator
 //! that adds emission only where BSDF-sampled paths happen to hit it.
 //!
 //! This file is the per-sample tracer; [`super`] drives it over the film.
@@ -19,12 +19,16 @@ const ROULETTE_START: u32 = 3;
 /// Options of the per-sample tracer.
 #[derive(Clone, Copy, Debug)]
 pub struct PathTracer {
+    /// Most scattering events per path: at 1, direct lighting only (emission
+    /// is still gathered at the vertex after the last scattering).
     pub max_depth: u32,
     /// Sample lights directly and weight by MIS (false: BSDF sampling only).
     pub light_sampling: bool,
 }
 
 impl PathTracer {
+    /// The tracer `settings` ask for: NEE with MIS, or BSDF sampling only for
+    /// [`IntegratorKind::BsdfOnly`].
     pub fn from_settings(settings: &RenderSettings) -> Self {
         Self {
             max_depth: settings.max_depth,

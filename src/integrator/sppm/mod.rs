@@ -129,6 +129,7 @@ pub struct SppmIntegrator {
 }
 
 impl SppmIntegrator {
+    /// An SPPM render of the whole image, iterations from 0.
     pub fn new(settings: &RenderSettings) -> Self {
         Self::with_share(settings, &Share::whole(settings.samples_per_pixel.unwrap_or(0)))
     }

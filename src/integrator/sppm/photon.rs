@@ -27,6 +27,8 @@ use std::f64::consts::PI;
 /// A photon leaving a light.
 #[derive(Clone, Copy, Debug)]
 pub struct Photon {
+    /// Where it starts (offset off the light's surface, or on a disc outside
+    /// the scene for sky photons) and which way it travels.
     pub ray: Ray,
     /// Flux carried, in watts per emitted photon (before dividing by the count).
     pub flux: Color,
@@ -54,6 +56,8 @@ pub struct PhotonSources {
 }
 
 impl PhotonSources {
+    /// The scene's photon sources: its emissive shapes, plus the sky if the
+    /// background is not black and the scene has finite, non-empty bounds.
     pub fn new(scene: &Scene) -> Self {
         let bounds = scene.bounds();
         let radius = 0.5 * bounds.extent().length();

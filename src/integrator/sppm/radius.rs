@@ -31,6 +31,8 @@ pub struct InitialRadius {
 }
 
 impl InitialRadius {
+    /// The start radius for a render at `height` pixels with `camera`'s
+    /// vertical field of view.
     pub fn new(parameters: &SppmSettings, camera: &Camera, height: u32) -> Self {
         Self {
             absolute: parameters.initial_radius,
@@ -38,6 +40,9 @@ impl InitialRadius {
         }
     }
 
+    /// The start radius of a visible point whose camera path travelled
+    /// `path_length` (scene units): the absolute setting if given, else
+    /// `INITIAL_RADIUS_PIXELS` pixel footprints at that distance.
     pub fn at_distance(&self, path_length: f64) -> f64 {
         self.absolute
             .unwrap_or((INITIAL_RADIUS_PIXELS * self.pixel_angle * path_length).max(1e-9))

@@ -44,6 +44,7 @@ pub enum RadiusSchedule {
 }
 
 impl RadiusSchedule {
+    /// Both schedules, for benchmarks that compare them.
     pub const ALL: [RadiusSchedule; 2] = [RadiusSchedule::PerPixel, RadiusSchedule::Global];
 
     /// The name in scene files and on the command line.

@@ -16,9 +16,12 @@ use crate::scene::Scene;
 /// Where one pixel's camera path met its first non-specular surface.
 #[derive(Clone, Copy, Debug)]
 pub struct VisiblePoint {
+    /// Position of the visible point, world space.
     pub point: DVec3,
     /// Geometric normal as the shape defines it (not flipped towards `wo`).
     pub geometric_normal: DVec3,
+    /// Shading frame at the point (the shading normal is +z); `wo` and BSDF
+    /// queries are in its coordinates.
     pub frame: ShadingFrame,
     /// Direction back along the camera path, in the local shading frame.
     pub wo: DVec3,
@@ -46,6 +49,8 @@ impl VisiblePoint {
 pub struct CameraPath {
     /// Emission seen directly or through specular bounces (already weighted).
     pub emitted: Color,
+    /// The first non-specular surface met, if the path reached one within
+    /// `max_depth` bounces.
     pub visible_point: Option<VisiblePoint>,
 }
 

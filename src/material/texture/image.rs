@@ -18,19 +18,37 @@ use std::sync::Arc;
 /// Why an image file could not become a texture. Every message names the file.
 #[derive(Debug, thiserror::Error)]
 pub enum ImageError {
+    /// The file could not be found, opened or read.
     #[error("cannot read image {}: {source}", path.display())]
-    Read { path: PathBuf, source: std::io::Error },
+    Read {
+        /// The image file.
+        path: PathBuf,
+        /// What the operating system reported.
+        source: std::io::Error,
+    },
+    /// The file is not an image in a format Prism decodes, or is damaged.
     #[error("cannot decode image {}: {source}", path.display())]
-    Decode { path: PathBuf, source: image::ImageError },
+    Decode {
+        /// The image file.
+        path: PathBuf,
+        /// What the decoder reported.
+        source: image::ImageError,
+    },
+    /// The image is zero texels wide or high.
     #[error("image {} has no pixels", path.display())]
-    Empty { path: PathBuf },
+    Empty {
+        /// The image file.
+        path: PathBuf,
+    },
 }
 
 /// What happens outside [0, 1]²: tile the picture, or stretch its border texels.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Wrap {
+    /// Tile the picture: u and u + 1 read the same texel.
     #[default]
     Repeat,
+    /// Extend the border texels outward.
     Clamp,
 }
 
@@ -113,10 +131,12 @@ impl Image {
         })
     }
 
+    /// Width in texels.
     pub fn width(&self) -> usize {
         self.width
     }
 
+    /// Height in texels.
     pub fn height(&self) -> usize {
         self.height
     }
@@ -195,6 +215,7 @@ impl ImageCache {
         self.images.len()
     }
 
+    /// Whether no file has been decoded yet.
     pub fn is_empty(&self) -> bool {
         self.images.is_empty()
     }

@@ -12,6 +12,7 @@ use std::f64::consts::{PI, TAU};
 /// A projection followed by a per-axis tiling factor.
 #[derive(Clone, Debug)]
 pub struct Mapping {
+    /// How the shading point becomes (u, v).
     pub projection: Projection,
     /// Repetitions per unit of the projected coordinates.
     pub scale: DVec2,
@@ -26,6 +27,7 @@ impl Default for Mapping {
     }
 }
 
+/// How a shading point becomes texture coordinates, before scaling.
 #[derive(Clone, Debug)]
 pub enum Projection {
     /// The shape's own parameterisation: a quad's [0, 1]², a mesh's OBJ uv,
@@ -39,6 +41,7 @@ pub enum Projection {
     Planar(PlanarProjection),
 }
 
+/// An equirectangular (latitude–longitude) projection, as for a globe.
 #[derive(Clone, Debug)]
 pub struct SphereProjection {
     /// World → globe rotation (the inverse of the globe's turn); `None` when unturned.
@@ -81,6 +84,8 @@ fn direction_of_sphere_uv(uv: DVec2) -> DVec3 {
     DVec3::new(sin_polar * longitude.sin(), cos_polar, sin_polar * longitude.cos())
 }
 
+/// A projection onto a parallelogram's affine coordinates; see
+/// [`Projection::Planar`].
 #[derive(Clone, Debug)]
 pub struct PlanarProjection {
     origin: DVec3,
@@ -113,6 +118,8 @@ impl PlanarProjection {
 }
 
 impl Mapping {
+    /// The texture coordinates of `at`: the projection's (u, v), times
+    /// `scale`.
     #[inline]
     pub fn map(&self, at: &ShadingPoint) -> DVec2 {
         let uv = match &self.projection {

@@ -17,17 +17,28 @@ use super::ShadingPoint;
 use crate::color::Color;
 use std::sync::Arc;
 
+/// A reflectance (linear RGB) that may vary over a surface, evaluated at a
+/// [`ShadingPoint`].
 #[derive(Clone, Debug)]
 pub enum Texture {
+    /// The same colour everywhere.
     Constant(Color),
     /// `wrap` is per axis (u, v): a globe repeats around but clamps at the poles.
     Image {
+        /// The decoded picture, shared by every texture that uses the file.
         image: Arc<Image>,
+        /// Where on the picture a point falls.
         mapping: Mapping,
+        /// What happens outside [0, 1] in u and in v.
         wrap: [Wrap; 2],
     },
+    /// Squares of two colours alternating in the mapped coordinates (see
+    /// [`procedural::checker`]).
     Checker {
+        /// The colours of even and odd squares.
         colors: [Color; 2],
+        /// Where in the pattern a point falls; its `scale` sets the squares
+        /// per unit.
         mapping: Mapping,
     },
     /// Along a world-space axis; no mapping.
@@ -35,6 +46,7 @@ pub enum Texture {
 }
 
 impl Texture {
+    /// The reflectance at `at`.
     #[inline]
     pub fn evaluate(&self, at: &ShadingPoint) -> Color {
         match self {

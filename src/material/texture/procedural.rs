@@ -15,10 +15,13 @@ pub fn checker(colors: &[Color; 2], uv: DVec2) -> Color {
 /// where `point·axis ≤ from`, `colors[1]` where it is ≥ `to`, linear between.
 #[derive(Clone, Debug)]
 pub struct Gradient {
+    /// The colours at `from` and at `to`.
     pub colors: [Color; 2],
     /// Unit direction of the ramp.
     pub axis: DVec3,
+    /// Where along `axis` (as `point·axis`) the ramp starts: `colors[0]`.
     pub from: f64,
+    /// Where along `axis` the ramp ends: `colors[1]`.
     pub to: f64,
 }
 
@@ -29,6 +32,7 @@ impl Gradient {
         (from != to && from.is_finite() && to.is_finite()).then_some(Self { colors, axis, from, to })
     }
 
+    /// The colour at world-space `point`.
     #[inline]
     pub fn evaluate(&self, point: DVec3) -> Color {
         let t = ((point.dot(self.axis) - self.from) / (self.to - self.from)).clamp(0.0, 1.0);

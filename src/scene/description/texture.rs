@@ -13,7 +13,9 @@ use std::fmt;
 /// A reflectance: a constant colour or a texture.
 #[derive(Debug, Clone)]
 pub enum ColorDescription {
+    /// A constant linear RGB colour, `[r, g, b]`.
     Rgb(Vector),
+    /// A texture table, `{ image = "…" }` and the like.
     Texture(Box<TextureDescription>),
 }
 
@@ -57,7 +59,9 @@ pub struct TextureDescription {
     pub center: Option<Vector>,
     /// Planar mapping: the parallelogram `origin + a·edge_u + b·edge_v` ↦ (a, b).
     pub origin: Option<Vector>,
+    /// Planar mapping: the side along which a (u) grows.
     pub edge_u: Option<Vector>,
+    /// Planar mapping: the side along which b (v) grows.
     pub edge_v: Option<Vector>,
     /// Repetitions per unit of mapped coordinates: a number or [u, v].
     pub scale: Option<Numbers<2>>,
@@ -66,29 +70,41 @@ pub struct TextureDescription {
     /// Gradient only: direction of the ramp (default +y) and where it starts
     /// and ends along it (default 0 and 1).
     pub axis: Option<Vector>,
+    /// Gradient only: where along `axis` the ramp starts (first colour).
     pub from: Option<f64>,
+    /// Gradient only: where along `axis` the ramp ends (second colour).
     pub to: Option<f64>,
 }
 
+/// The `mapping` key: how points become texture coordinates (see
+/// [`crate::material::texture::Projection`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum MappingKind {
+    /// The shape's own uv parameterisation (the default).
     Uv,
+    /// Latitude and longitude of the direction from a centre, as on a globe.
     Sphere,
+    /// Affine coordinates in a parallelogram (`origin`, `edge_u`, `edge_v`).
     Planar,
 }
 
+/// The `wrap` key of an image texture.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum WrapKind {
+    /// Tile the picture (the default).
     Repeat,
+    /// Extend the border texels.
     Clamp,
 }
 
 /// A number (meaning the same value for every component) or an array of `N`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Numbers<const N: usize> {
+    /// A single number.
     One(f64),
+    /// One number per component.
     Each([f64; N]),
 }
 
@@ -125,6 +141,7 @@ impl<'de, const N: usize> Deserialize<'de> for Numbers<N> {
 }
 
 impl<const N: usize> Numbers<N> {
+    /// The `N` components; a single number is repeated `N` times.
     pub fn to_array(self) -> [f64; N] {
         match self {
             Numbers::One(v) => [v; N],
