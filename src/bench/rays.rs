@@ -328,9 +328,15 @@ pub fn write_results(builds: &[BuildRow], rows: &[RayRow], machine: &str, direct
 
 /// Writes each mesh (`NAME.vertices.f32`: x y z per vertex, as stored;
 /// `NAME.faces.u32`), each ray set (`NAME-SET.rays.f32`: origin and
-/// direction per ray) and Prism's closest-hit answers
-/// (`NAME-SET.prism.f64`: face index, or −1, and distance per ray), all
+/// direction per ray), Prism's closest-hit answers (`NAME-SET.prism.f64`:
+/// face index, or −1, and distance per ray) and its occlusion answers
+/// (`NAME-SET.prism-occluded.u8`: 1 where `occluded` finds a hit), all
 /// little-endian, for a peer to trace and compare.
+///
+/// The stored vertices are an `f64` anchor plus `f32` offsets
+/// (`geometry::triangles`); written as `f32`, each moves by at most half an
+/// `f32` step of its coordinate, so a peer's distances agree to about 10⁻⁷
+/// relative and only rays within that of an edge may hit differently.
 pub fn export(meshes: &[(String, Mesh)], directory: &Path) -> Result<(), BenchError> {
     let io = |path: &Path| {
         let path = path.display().to_string();
@@ -379,6 +385,11 @@ pub fn export(meshes: &[(String, Mesh)], directory: &Path) -> Result<(), BenchEr
                 .flat_map(f64::to_le_bytes)
                 .collect();
             write(&directory.join(format!("{name}-{set}.prism.f64")), answers)?;
+            let occluded: Vec<u8> = rays
+                .par_iter()
+                .map(|ray| u8::from(scene.occluded(ray, f64::INFINITY)))
+                .collect();
+            write(&directory.join(format!("{name}-{set}.prism-occluded.u8")), occluded)?;
         }
     }
     Ok(())
