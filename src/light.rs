@@ -1,11 +1,13 @@
 //! Emissive primitives as lights: a light is chosen in proportion to its
 //! power, then its surface samples itself as seen from the shading point
 //! (`Shape::sample_from`: the cone a sphere subtends, the area of anything
-//! else). Lights only select and weight; the densities they return are the
-//! ones the path tracer's MIS weights recompute for BSDF-sampled hits.
+//! else; or, for a sphere cut by opaque spheres, `ClippedSphere::sample_from`:
+//! the part the point might see). Lights only select and weight; the
+//! densities they return are the ones the path tracer's MIS weights
+//! recompute for BSDF-sampled hits.
 
 use crate::color::{Color, luminance};
-use crate::geometry::{AreaSample, Shape, ShapeSample, Triangle};
+use crate::geometry::{AreaSample, ClippedSphere, Shape, ShapeSample, Triangle};
 use glam::{DVec2, DVec3};
 
 /// One emissive primitive.
@@ -18,6 +20,10 @@ pub struct Light {
     /// Whether it emits from both faces; otherwise only towards the side its
     /// geometric normal points to.
     pub two_sided: bool,
+    /// For a sphere whose surface opaque spheres cross: the sphere with
+    /// them, which samples only what a point might see. `None` otherwise
+    /// (the primitive's shape samples itself).
+    pub clipped: Option<Box<ClippedSphere>>,
 }
 
 /// A point chosen on a light, seen from a reference point.
@@ -166,7 +172,10 @@ impl Lights {
     pub fn sample(&self, source: &impl EmitterSource, reference: DVec3, u_select: f64, u: DVec2) -> Option<LightSample> {
         let (index, selection) = self.choose(u_select)?;
         let light = &self.lights[index as usize];
-        let sample = source.emitter(light.primitive).sample_from(reference, u)?;
+        let sample = match &light.clipped {
+            Some(clipped) => clipped.sample_from(reference, u),
+            None => source.emitter(light.primitive).sample_from(reference, u),
+        }?;
         let to_light = sample.point - reference;
         let distance = to_light.length();
         let wi = to_light / distance;
@@ -190,6 +199,10 @@ impl Lights {
     /// selection probability included.
     pub fn pdf(&self, source: &impl EmitterSource, index: u32, reference: DVec3, point: DVec3, normal: DVec3) -> f64 {
         let light = &self.lights[index as usize];
-        source.emitter(light.primitive).pdf_from(reference, point, normal) * self.probability[index as usize]
+        let pdf = match &light.clipped {
+            Some(clipped) => clipped.pdf_from(reference, point, normal),
+            None => source.emitter(light.primitive).pdf_from(reference, point, normal),
+        };
+        pdf * self.probability[index as usize]
     }
 }

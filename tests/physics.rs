@@ -212,3 +212,92 @@ material = "lamp"
     };
     assert_estimators_agree(&loaded, job, 0.05, 0.05);
 }
+
+/// smallpt's light is a radius-600 sphere poking 0.27 through the ceiling
+/// sphere; only the cap inside the room is sampled (`geometry::
+/// clipped_sphere`). Against the unclipped light (the cone the whole sphere
+/// subtends, 95% of it hidden by the ceiling) and BSDF sampling alone, the
+/// image means must agree within four combined standard errors of 8 runs
+/// each, for direct light (depth 1) and full paths; four rather than three
+/// because six channel comparisons per depth are made. (The noise each
+/// sampling leaves is measured in docs/performance.md: an image mean mixes it
+/// with that of the light seen directly and through the balls.)
+#[test]
+fn clipped_smallpt_light_agrees_with_unclipped_and_bsdf_sampling() {
+    use prism::light::{Light, Lights};
+    let clipped = shipped_scene("smallpt.toml");
+    let clips = clipped.scene.lights.lights.iter().filter_map(|l| l.clipped.as_ref());
+    assert_eq!(
+        clips.map(|c| c.clip_count()).collect::<Vec<_>>(),
+        [5],
+        "the ceiling and four walls cross the light"
+    );
+    let mut unclipped = shipped_scene("smallpt.toml");
+    let lights: Vec<Light> = unclipped
+        .scene
+        .lights
+        .lights
+        .iter()
+        .map(|light| Light {
+            clipped: None,
+            ..light.clone()
+        })
+        .collect();
+    unclipped.scene.lights = Lights::new(lights, &unclipped.scene);
+
+    for max_depth in [1, 6] {
+        let job = Job {
+            width: 24,
+            height: 18,
+            spp: 16,
+            max_depth,
+            sampler: prism::sampler::SamplerKind::Random,
+            ..Job::default()
+        };
+        let estimate = |loaded, integrator| mean_and_error(loaded, &Job { integrator, ..job }, 8);
+        let (cap, cap_error) = estimate(&clipped, IntegratorKind::PathTracing);
+        let (cone, cone_error) = estimate(&unclipped, IntegratorKind::PathTracing);
+        let (bsdf, bsdf_error) = estimate(&clipped, IntegratorKind::BsdfOnly);
+        eprintln!(
+            "depth {max_depth}: cap {cap:?} ± {cap_error:?}, cone {cone:?} ± {cone_error:?}, BSDF {bsdf:?} ± {bsdf_error:?}"
+        );
+        for c in 0..3 {
+            for (name, other, other_error) in [("cone", cone, cone_error), ("BSDF", bsdf, bsdf_error)] {
+                let combined = (cap_error[c].powi(2) + other_error[c].powi(2)).sqrt();
+                assert!(
+                    (cap[c] - other[c]).abs() < 4.0 * combined,
+                    "depth {max_depth}, channel {c}: cap {} ± {}, {name} {} ± {}",
+                    cap[c],
+                    cap_error[c],
+                    other[c],
+                    other_error[c]
+                );
+            }
+            assert!(
+                cap_error[c] < 0.05 * cap[c],
+                "depth {max_depth}: the comparison needs teeth: {cap:?} ± {cap_error:?}"
+            );
+        }
+    }
+}
+
+/// Only a spherical light that an opaque sphere's surface crosses is
+/// clipped: no other shipped scene pays for it.
+#[test]
+fn only_smallpt_has_a_clipped_light() {
+    let folder = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let Ok(entries) = std::fs::read_dir(&folder) else {
+        panic!("cannot list {}", folder.display());
+    };
+    let mut names: Vec<String> = entries
+        .filter_map(|entry| entry.ok()?.file_name().into_string().ok())
+        .filter(|name| name.ends_with(".toml"))
+        .collect();
+    names.sort();
+    assert!(names.len() > 5 && names.contains(&"smallpt.toml".to_string()), "{names:?}");
+    for name in names {
+        let loaded = shipped_scene(&name);
+        let clipped = loaded.scene.lights.lights.iter().any(|l| l.clipped.is_some());
+        assert_eq!(clipped, name == "smallpt.toml", "{name}");
+    }
+}

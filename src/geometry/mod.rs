@@ -10,6 +10,7 @@
 
 pub mod axis_box;
 pub mod bezier;
+pub mod clipped_sphere;
 pub mod hit;
 pub mod mesh;
 pub mod quad;
@@ -21,6 +22,7 @@ pub mod triangle;
 pub mod triangles;
 
 pub use axis_box::AxisBox;
+pub use clipped_sphere::ClippedSphere;
 pub use hit::{AreaSample, SurfaceHit};
 pub use mesh::Mesh;
 pub use quad::Quad;

@@ -69,9 +69,7 @@ impl Sphere {
     /// The hit record for a point near the surface, reprojected onto it.
     fn hit_at(&self, approximate_point: DVec3, t: f64) -> SurfaceHit {
         let normal = (approximate_point - self.center).normalize();
-        let point = self.center + self.radius * normal;
-        // Reprojection error: a handful of roundings on |p| (pbrt-v4 6.8.5).
-        let point_error = gamma(5) * (point.abs() + self.center.abs());
+        let (point, point_error) = self.point_with_normal(normal);
         SurfaceHit {
             t,
             point,
@@ -80,6 +78,14 @@ impl Sphere {
             shading_normal: normal,
             uv: Self::uv_of(normal),
         }
+    }
+
+    /// The surface point whose outward unit normal is `normal`, with its
+    /// per-axis error bound: a handful of roundings on |p| (pbrt-v4 6.8.5).
+    #[inline]
+    pub fn point_with_normal(&self, normal: DVec3) -> (DVec3, DVec3) {
+        let point = self.center + self.radius * normal;
+        (point, gamma(5) * (point.abs() + self.center.abs()))
     }
 
     /// Equirectangular coordinates of a unit direction from the centre:
@@ -131,6 +137,19 @@ impl Sphere {
             warp::uniform_cone_pdf(self.cone_cos_max(reference))
         } else {
             sampling::pdf_by_area(self.area(), reference, point, normal)
+        }
+    }
+
+    /// Area of the part of the surface [`Sphere::sample_from`] draws from
+    /// at `reference`: from outside, the cap in front of the horizon, whose
+    /// normals lie within acos(r / d) of the direction to the reference
+    /// (area 2πr²(1 − r/d)); from inside, the whole sphere.
+    pub fn sampled_area_from(&self, reference: DVec3) -> f64 {
+        if self.is_outside(reference) {
+            let distance = (reference - self.center).length();
+            2.0 * PI * self.radius * self.radius * (1.0 - self.radius / distance)
+        } else {
+            self.area()
         }
     }
 

@@ -97,6 +97,12 @@ impl Material {
         matches!(self, Material::Mirror { .. } | Material::Glass { .. })
     }
 
+    /// True if no light passes through the surface (everything but glass):
+    /// a closed surface of it separates inside from outside.
+    pub fn is_opaque(&self) -> bool {
+        !matches!(self, Material::Glass { .. })
+    }
+
     /// True if the material scatters light at all.
     pub fn scatters(&self) -> bool {
         !matches!(self, Material::Emissive { .. })

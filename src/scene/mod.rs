@@ -19,9 +19,10 @@ pub use similarity::{Similarity, load_scene_str_placed};
 
 use crate::accel::{BuildPrimitive, Bvh};
 use crate::color::Color;
+use crate::geometry::clipped_sphere::clip_emitters;
 use crate::geometry::triangle::TriangleRay;
 use crate::geometry::triangles::{LeafHit, TriangleSource, Triangles, store_mesh_positions, stored_position};
-use crate::geometry::{Mesh, Shape, SurfaceHit, Triangle};
+use crate::geometry::{Mesh, Shape, Sphere, SurfaceHit, Triangle};
 use crate::light::{Emitter, EmitterSource, Light, Lights};
 use crate::material::{Material, Texture};
 use crate::math::{Aabb, Ray};
@@ -130,12 +131,47 @@ impl Scene {
                     primitive,
                     radiance: *radiance,
                     two_sided: *two_sided,
+                    clipped: None,
                 }),
                 _ => None,
             })
             .collect();
+        let lights = scene.clip_sphere_lights(lights);
         scene.lights = Lights::new(lights, &scene);
         scene
+    }
+
+    /// Gives each spherical light the opaque spheres whose surfaces cross
+    /// its own (see `geometry::clipped_sphere`), so it samples only what a
+    /// shading point might see: smallpt's light pokes through the ceiling
+    /// and only a small cap of it shows in the room.
+    fn clip_sphere_lights(&self, mut lights: Vec<Light>) -> Vec<Light> {
+        let sphere_of = |primitive: &Primitive| match primitive.shape {
+            Shape::Sphere(sphere) => Some(sphere),
+            _ => None,
+        };
+        let spherical: Vec<(usize, Sphere)> = lights
+            .iter()
+            .enumerate()
+            .filter_map(|(index, light)| {
+                let primitive = self.shapes.get(light.primitive as usize)?;
+                sphere_of(primitive).map(|sphere| (index, sphere))
+            })
+            .collect();
+        if spherical.is_empty() {
+            return lights;
+        }
+        let opaque: Vec<Sphere> = self
+            .shapes
+            .iter()
+            .filter(|primitive| self.materials[primitive.material as usize].is_opaque())
+            .filter_map(sphere_of)
+            .collect();
+        let emitters: Vec<Sphere> = spherical.iter().map(|&(_, sphere)| sphere).collect();
+        for ((index, _), clipped) in spherical.iter().zip(clip_emitters(&emitters, &opaque)) {
+            lights[*index].clipped = clipped.map(Box::new);
+        }
+        lights
     }
 
     /// A scene of one mesh, each triangle a primitive of one grey diffuse
