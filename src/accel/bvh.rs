@@ -558,23 +558,29 @@ mod tests {
         let probe = random_boxes(2000, 999);
         for b in &probe {
             let ray = Ray::new(b.min * 1.2 - DVec3::splat(10.0), b.max - DVec3::splat(50.0));
-            let inverse = DVec3::ONE / ray.direction;
-            let brute = boxes
-                .iter()
-                .filter_map(|b| b.hit_distance(ray.origin, inverse, f64::INFINITY))
-                .fold(f64::INFINITY, f64::min);
-            let mut t_max = f64::INFINITY;
-            bvh.traverse(&ray, &mut t_max, |leaf, t_max| {
-                for i in leaf.first..leaf.first + leaf.count {
-                    let original = orders[leaf.kind as usize][i as usize] as usize;
-                    if let Some(t) = boxes[original].hit_distance(ray.origin, inverse, *t_max) {
-                        *t_max = t;
-                    }
-                }
-                false
-            });
+            let (brute, t_max) = nearest_box_both_ways(&bvh, &orders, &boxes, &ray);
             assert_eq!(brute, t_max);
         }
+    }
+
+    /// The nearest box hit along `ray`, by testing every box and through the BVH.
+    fn nearest_box_both_ways(bvh: &Bvh, orders: &[Vec<u32>; KIND_COUNT], boxes: &[Aabb], ray: &Ray) -> (f64, f64) {
+        let inverse = DVec3::ONE / ray.direction;
+        let brute = boxes
+            .iter()
+            .filter_map(|b| b.hit_distance(ray.origin, inverse, f64::INFINITY))
+            .fold(f64::INFINITY, f64::min);
+        let mut t_max = f64::INFINITY;
+        bvh.traverse(ray, &mut t_max, |leaf, t_max| {
+            for i in leaf.first..leaf.first + leaf.count {
+                let original = orders[leaf.kind as usize][i as usize] as usize;
+                if let Some(t) = boxes[original].hit_distance(ray.origin, inverse, *t_max) {
+                    *t_max = t;
+                }
+            }
+            false
+        });
+        (brute, t_max)
     }
 
     /// Boxes spaced geometrically along a line make the SAH peel off a few
@@ -594,21 +600,7 @@ mod tests {
         for i in 0..100 {
             let origin = DVec3::new(-10.0, 0.3 * (i as f64 / 100.0) - 0.1, 0.2);
             let ray = Ray::new(origin, DVec3::new(1.0, 0.0, 0.001 * i as f64));
-            let inverse = DVec3::ONE / ray.direction;
-            let brute = boxes
-                .iter()
-                .filter_map(|b| b.hit_distance(ray.origin, inverse, f64::INFINITY))
-                .fold(f64::INFINITY, f64::min);
-            let mut t_max = f64::INFINITY;
-            bvh.traverse(&ray, &mut t_max, |leaf, t_max| {
-                for k in leaf.first..leaf.first + leaf.count {
-                    let original = orders[0][k as usize] as usize;
-                    if let Some(t) = boxes[original].hit_distance(ray.origin, inverse, *t_max) {
-                        *t_max = t;
-                    }
-                }
-                false
-            });
+            let (brute, t_max) = nearest_box_both_ways(&bvh, &orders, &boxes, &ray);
             assert_eq!(brute, t_max);
         }
     }
