@@ -31,5 +31,6 @@ pub mod render;
 pub mod sampler;
 pub mod scene;
 pub mod settings;
+pub mod spectrum;
 #[cfg(feature = "viewer")]
 pub mod viewer;

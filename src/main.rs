@@ -99,6 +99,10 @@ struct RenderArgs {
     /// max(mean luminance, 0.01) is below this (e.g. 0.02).
     #[arg(long)]
     adaptive_threshold: Option<f64>,
+    /// Spectral transport: 4 hero wavelengths per path instead of RGB
+    /// (scenes with dispersive glass are spectral anyway).
+    #[arg(long)]
+    spectral: bool,
     /// SPPM: photons traced per iteration.
     #[arg(long)]
     photons: Option<u32>,
@@ -239,6 +243,7 @@ fn apply_overrides(settings: &mut RenderSettings, args: &RenderArgs) -> Result<(
         alpha: args.alpha,
         radius_schedule: args.radius_schedule,
         adaptive_threshold: args.adaptive_threshold,
+        spectral: args.spectral.then_some(true),
         time_seconds: args.time,
     };
     patch.apply_to(settings)?;

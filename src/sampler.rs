@@ -125,6 +125,19 @@ impl Sampler {
         laine_karras_permutation(self.reversed_index, seed).reverse_bits()
     }
 
+    /// A second stream of the same pixel sample, scrambled independently
+    /// of this one by `salt` and starting at its first (Sobol') dimension:
+    /// for draws that must not shift this stream's dimensions, such as a
+    /// spectral path's wavelengths (so an RGB and a spectral render of one
+    /// seed follow the same paths wherever their throughputs agree).
+    pub fn side_stream(&self, salt: u64) -> Self {
+        Self {
+            stream_seed: mix64(self.stream_seed ^ salt),
+            dimension: 0,
+            ..self.clone()
+        }
+    }
+
     fn next_dimension_seed(&mut self) -> u64 {
         self.dimension += 1;
         mix64(self.stream_seed ^ (self.dimension as u64).wrapping_mul(0xd1b5_4a32_d192_ed03))

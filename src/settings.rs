@@ -84,6 +84,10 @@ pub struct RenderSettings {
     /// Render only this part of the image (the viewer's region render);
     /// `None` renders the whole frame. Pixels outside it get no samples.
     pub region: Option<Region>,
+    /// Carry sampled wavelengths instead of RGB (hero-wavelength spectral
+    /// transport, see `spectrum`); a scene with dispersive glass is rendered
+    /// spectrally whatever this says.
+    pub spectral: bool,
 }
 
 /// A rectangle of the image in film coordinates ([0, 1]², y down), so it
@@ -169,6 +173,7 @@ impl Default for RenderSettings {
             sppm: SppmSettings::default(),
             adaptive_threshold: None,
             region: None,
+            spectral: false,
         }
     }
 }

@@ -87,7 +87,7 @@ fn mtl_materials_map_onto_prism_materials() {
         other => panic!("lamp: {other:?}"),
     }
     match material_of_face(&loaded, 1) {
-        Material::Glass { ior, tint } => {
+        Material::Glass { ior, tint, .. } => {
             // f32 in the .mtl: compare to f32 precision.
             assert!((ior - 1.33).abs() < 1e-6 && (*tint - DVec3::new(0.9, 1.0, 0.95)).abs().max_element() < 1e-6);
         }

@@ -113,7 +113,16 @@ fn hash_material(hash: &mut Fnv1a, material: &Material) {
                 }
             }
         }
-        _ => hash.debug(material),
+        // A glass without dispersion hashes as it did before glasses could
+        // disperse, so films rendered earlier still merge.
+        _ => match material {
+            Material::Glass {
+                ior,
+                tint,
+                dispersion: None,
+            } => hash.debug(&format_args!("Glass {{ ior: {ior:?}, tint: {tint:?} }}")),
+            _ => hash.debug(material),
+        },
     }
 }
 

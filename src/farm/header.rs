@@ -100,6 +100,10 @@ pub fn image_identity(settings: &RenderSettings, scene_hash: &str) -> BTreeMap<S
     put("sampler", settings.sampler.to_string());
     put("seed", settings.seed.to_string());
     put("max_depth", settings.max_depth.to_string());
+    if settings.spectral {
+        // Only when set, so RGB films keep the headers they always had.
+        put("spectral", "true".to_string());
+    }
     match settings.integrator {
         IntegratorKind::PathTracing | IntegratorKind::BsdfOnly => {
             let threshold = settings.adaptive_threshold.map_or("off".into(), |t| format!("{t:?}"));

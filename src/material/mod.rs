@@ -15,6 +15,7 @@ pub mod texture;
 pub use texture::Texture;
 
 use crate::color::Color;
+use crate::spectrum::dispersion::Dispersion;
 use glam::{DVec2, DVec3};
 
 /// Which quantity a path carries: radiance from the camera, or importance
@@ -72,6 +73,10 @@ pub enum Material {
         ior: f64,
         /// Colour multiplying both reflection and transmission.
         tint: Color,
+        /// How the index varies with wavelength (`None`: it does not). An
+        /// RGB render uses `ior`, the index at the d line; a spectral one
+        /// refracts each path's hero wavelength by its own index.
+        dispersion: Option<Dispersion>,
     },
     /// A rough conductor, GGX microfacets (see [`glossy`]).
     Glossy {
@@ -101,6 +106,12 @@ impl Material {
     /// a closed surface of it separates inside from outside.
     pub fn is_opaque(&self) -> bool {
         !matches!(self, Material::Glass { .. })
+    }
+
+    /// True if the scattering depends on wavelength (dispersive glass): a
+    /// scene with such a material is rendered spectrally.
+    pub fn is_dispersive(&self) -> bool {
+        matches!(self, Material::Glass { dispersion: Some(_), .. })
     }
 
     /// True if the material scatters light at all.
@@ -162,8 +173,32 @@ impl Material {
             Material::Diffuse { albedo } => diffuse::sample(albedo.evaluate(at), wo, u),
             Material::Glossy { tint, roughness } => glossy::sample(tint.evaluate(at), *roughness, wo, u),
             Material::Mirror { tint } => mirror::sample(tint.evaluate(at), wo),
-            Material::Glass { ior, tint } => dielectric::sample(*ior, *tint, wo, u_lobe, transport),
+            Material::Glass { ior, tint, .. } => dielectric::sample(*ior, *tint, wo, u_lobe, transport),
             Material::Emissive { .. } => None,
+        }
+    }
+}
+
+impl Material {
+    /// [`sample`](Self::sample) for light of wavelength `lambda_nm`: a
+    /// dispersive glass refracts by its index there; everything else
+    /// ignores the wavelength.
+    pub fn sample_at_wavelength(
+        &self,
+        wo: DVec3,
+        at: &ShadingPoint,
+        u: DVec2,
+        u_lobe: f64,
+        transport: Transport,
+        lambda_nm: f64,
+    ) -> Option<BsdfSample> {
+        match self {
+            Material::Glass {
+                tint,
+                dispersion: Some(dispersion),
+                ..
+            } => dielectric::sample(dispersion.ior(lambda_nm), *tint, wo, u_lobe, transport),
+            _ => self.sample(wo, at, u, u_lobe, transport),
         }
     }
 }

@@ -173,7 +173,11 @@ fn fresnel_cook_torrance(c: f64, eta: f64) -> f64 {
 /// refracted (Veach 1997, §5.2).
 fn glass_lobe_counts(ior: f64, wo: DVec3, n: u32, seed: u64, transport: Transport) -> [u64; 2] {
     let tint = Color::new(0.9, 0.8, 0.7);
-    let glass = Material::Glass { ior, tint };
+    let glass = Material::Glass {
+        ior,
+        tint,
+        dispersion: None,
+    };
     let eta = if wo.z > 0.0 { ior } else { 1.0 / ior };
     let reflectance = fresnel_cook_torrance(wo.z.abs(), eta);
     let mut counts = [0u64; 2];
@@ -332,6 +336,7 @@ fn sample_reads_only_the_inputs_it_declares() {
         Material::Glass {
             ior: 1.5,
             tint: Color::ONE,
+            dispersion: None,
         },
     ];
     let inputs = [

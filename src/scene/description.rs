@@ -91,9 +91,16 @@ pub enum MaterialDescription {
     },
     /// Smooth glass.
     Glass {
-        /// Index of refraction inside over outside (positive); default 1.5.
-        #[serde(default = "default_ior")]
-        ior: f64,
+        /// Index of refraction inside over outside (positive); default 1.5,
+        /// or the named glass's nd. With `abbe`, the index at the d line.
+        ior: Option<f64>,
+        /// A named dispersive glass: `BK7`, `fused-silica` or `SF11`.
+        #[serde(default)]
+        glass: Option<String>,
+        /// Abbe number: makes the glass dispersive, n(λ) by Cauchy's law
+        /// through `ior` (nd) and this.
+        #[serde(default)]
+        abbe: Option<f64>,
         /// Colour multiplying reflection and transmission; default white.
         #[serde(default = "white")]
         tint: Vector,
@@ -121,10 +128,6 @@ fn white() -> Vector {
 
 fn white_texture() -> ColorDescription {
     ColorDescription::Rgb(white())
-}
-
-fn default_ior() -> f64 {
-    1.5
 }
 
 /// Placement of a mesh: scale, then rotate (degrees about x, y, z), then translate.

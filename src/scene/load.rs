@@ -18,6 +18,7 @@ use crate::material::texture::ImageCache;
 use crate::math::Aabb;
 use crate::settings::validate::available_memory;
 use crate::settings::{RenderSettings, Setting, SettingError};
+use crate::spectrum::dispersion::Dispersion;
 use glam::{DAffine3, DVec2, DVec3};
 use std::cell::RefCell;
 use std::collections::HashMap;
@@ -35,6 +36,8 @@ mod texture;
 /// coordinates: 10²⁴ is far from f64's limit. See docs/scene-format.md,
 /// "Coordinates".
 pub const COORDINATE_LIMIT: f64 = 1e12;
+/// A glass's index when the file gives neither `ior` nor a named `glass`.
+const DEFAULT_IOR: f64 = 1.5;
 
 /// A scene ready to render, with the camera and settings its file asked for.
 #[derive(Debug)]
@@ -310,14 +313,55 @@ impl Builder<'_> {
             MaterialDescription::Mirror { tint } => Material::Mirror {
                 tint: self.texture(&path.key("tint"), tint, false, images)?,
             },
-            MaterialDescription::Glass { ior, tint } => {
-                self.finite(&path.key("ior"), &[*ior])?;
-                if *ior <= 0.0 {
+            MaterialDescription::Glass { ior, glass, abbe, tint } => {
+                let dispersion = match (glass, abbe) {
+                    (Some(_), Some(_)) => {
+                        return Err(self.error(
+                            &path.key("abbe"),
+                            "a named glass has its own dispersion: give `glass` or `abbe`, not both",
+                        ));
+                    }
+                    (Some(name), None) => {
+                        if ior.is_some() {
+                            return Err(self.error(
+                                &path.key("ior"),
+                                format!("the glass {name} has its own index: give `glass` or `ior`, not both"),
+                            ));
+                        }
+                        let names: Vec<&str> = Dispersion::NAMED.iter().map(|(n, _)| *n).collect();
+                        let found = Dispersion::named(name);
+                        Some(found.ok_or_else(|| {
+                            self.error(
+                                &path.key("glass"),
+                                format!("unknown glass {name:?} (known: {})", names.join(", ")),
+                            )
+                        })?)
+                    }
+                    (None, Some(abbe)) => {
+                        self.finite(&path.key("abbe"), &[*abbe])?;
+                        if *abbe <= 0.0 {
+                            return Err(self.error(&path.key("abbe"), format!("must be positive (found {abbe})")));
+                        }
+                        Some(Dispersion::from_abbe(ior.unwrap_or(DEFAULT_IOR), *abbe))
+                    }
+                    (None, None) => None,
+                };
+                let ior = match (ior, dispersion) {
+                    (Some(ior), _) => *ior,
+                    (None, Some(dispersion)) => dispersion.nd(),
+                    (None, None) => DEFAULT_IOR,
+                };
+                self.finite(&path.key("ior"), &[ior])?;
+                if ior <= 1.0 && dispersion.is_some() {
+                    return Err(self.error(&path.key("ior"), format!("a dispersive glass needs nd above 1 (found {ior})")));
+                }
+                if ior <= 0.0 {
                     return Err(self.error(&path.key("ior"), format!("must be positive (found {ior})")));
                 }
                 Material::Glass {
-                    ior: *ior,
+                    ior,
                     tint: self.color(&path.key("tint"), *tint)?,
+                    dispersion,
                 }
             }
             MaterialDescription::Glossy { tint, roughness } => {

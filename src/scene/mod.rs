@@ -214,7 +214,13 @@ impl Scene {
         }
     }
 
-    /// The material of a primitive.
+    /// Whether any material's scattering depends on wavelength (dispersive
+    /// glass): such a scene is rendered spectrally.
+    pub fn has_dispersion(&self) -> bool {
+        self.materials.iter().any(Material::is_dispersive)
+    }
+
+    /// The material of primitive `primitive`.
     pub fn material_of(&self, primitive: u32) -> &Material {
         &self.materials[self.material_index(primitive) as usize]
     }

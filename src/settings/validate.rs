@@ -82,6 +82,8 @@ pub enum Setting {
     /// Relative standard error at which a pixel stops taking samples;
     /// positive.
     AdaptiveThreshold,
+    /// Spectral transport (true) or RGB (false, the default).
+    Spectral,
     /// Worker threads, 1 to [`MAX_THREADS`] (command line only).
     Threads,
     /// Exposure in stops, within ±[`MAX_EXPOSURE_STOPS`] (command line only;
@@ -105,6 +107,7 @@ impl Setting {
             Setting::Alpha => "alpha",
             Setting::RadiusSchedule => "radius_schedule",
             Setting::AdaptiveThreshold => "adaptive_threshold",
+            Setting::Spectral => "spectral",
             Setting::TimeLimit | Setting::Threads | Setting::Exposure => return None,
         })
     }
@@ -125,6 +128,7 @@ impl Setting {
             Setting::Alpha => "--alpha",
             Setting::RadiusSchedule => "--radius-schedule",
             Setting::AdaptiveThreshold => "--adaptive-threshold",
+            Setting::Spectral => "--spectral",
             Setting::Threads => "--threads",
             Setting::Exposure => "--exposure",
         }
@@ -188,6 +192,8 @@ pub struct SettingsPatch {
     pub radius_schedule: Option<RadiusSchedule>,
     /// Relative standard error at which a pixel stops taking samples.
     pub adaptive_threshold: Option<f64>,
+    /// Spectral transport (`--spectral`).
+    pub spectral: Option<bool>,
     /// Command line only: render for this long instead of to a sample count.
     #[serde(skip)]
     pub time_seconds: Option<f64>,
@@ -256,6 +262,7 @@ impl SettingsPatch {
             }
             next.adaptive_threshold = Some(threshold);
         }
+        next.spectral = self.spectral.unwrap_or(next.spectral);
         *settings = next;
         Ok(())
     }

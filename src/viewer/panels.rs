@@ -152,6 +152,10 @@ fn ui_render(app: &mut ViewerApp, ui: &mut Ui) {
             }
         });
 
+    ui.checkbox(&mut app.settings.spectral, "Spectral").on_hover_text(
+        "Carry 4 sampled wavelengths per path instead of RGB (path tracing; scenes with dispersive glass are always spectral)",
+    );
+
     let sppm = app.settings.integrator == IntegratorKind::Sppm;
     let mut unlimited = app.settings.samples_per_pixel.is_none();
     ui.horizontal(|ui| {

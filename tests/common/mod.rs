@@ -31,6 +31,8 @@ pub struct Job {
     pub seed: u64,
     pub max_depth: u32,
     pub threads: Option<usize>,
+    /// Spectral transport (the scene's own setting also turns it on).
+    pub spectral: bool,
 }
 
 impl Default for Job {
@@ -44,6 +46,7 @@ impl Default for Job {
             seed: 1,
             max_depth: 64,
             threads: None,
+            spectral: false,
         }
     }
 }
@@ -58,6 +61,7 @@ pub fn render(loaded: &LoadedScene, job: &Job) -> Frame {
         integrator: job.integrator,
         sampler: job.sampler,
         seed: job.seed,
+        spectral: job.spectral || loaded.settings.spectral,
         ..loaded.settings.clone()
     };
     match render_with_threads(&loaded.scene, &loaded.camera, &settings, job.threads) {

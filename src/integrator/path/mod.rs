@@ -59,6 +59,25 @@ impl PathIntegrator {
     }
 }
 
+impl PathIntegrator {
+    /// One sample in every pixel still sampled, by `radiance` (the RGB or
+    /// the spectral tracer); false if cancelled.
+    fn add_pass<F>(&mut self, scene: &Scene, camera: &Camera, cancel: &AtomicBool, radiance: F) -> bool
+    where
+        F: Fn(&PathTracer, &Scene, Ray, &mut Sampler) -> crate::color::Color + Sync,
+    {
+        let sample_index = self.first_sample + self.passes;
+        let (tracer, kind, seed) = (self.tracer, self.sampler, self.seed);
+        let size = (self.film.width, self.film.height);
+        let (pixels, rows) = (self.settings.sampled_pixels(), self.rows);
+        pass::add_samples_adaptive(&mut self.film, pixels, rows, cancel, self.adaptive_threshold, |x, y| {
+            let mut sampler = Sampler::new(kind, y as u64 * size.0 as u64 + x as u64, sample_index, seed);
+            let ray = camera_ray(camera, size, x, y, &mut sampler);
+            radiance(&tracer, scene, ray, &mut sampler)
+        })
+    }
+}
+
 /// The camera ray of one pixel sample; consumes the sampler's first two
 /// dimensions (film position within the pixel: a box filter, and lens).
 pub fn camera_ray(camera: &Camera, (width, height): (u32, u32), x: u32, y: u32, sampler: &mut Sampler) -> Ray {
@@ -70,17 +89,15 @@ pub fn camera_ray(camera: &Camera, (width, height): (u32, u32), x: u32, y: u32, 
 
 impl Integrator for PathIntegrator {
     fn render_pass(&mut self, scene: &Scene, camera: &Camera, cancel: &AtomicBool) -> bool {
-        let sample_index = self.first_sample + self.passes;
-        let (tracer, kind, seed) = (self.tracer, self.sampler, self.seed);
-        let size = (self.film.width, self.film.height);
-        let (pixels, rows) = (self.settings.sampled_pixels(), self.rows);
-        let completed = pass::add_samples_adaptive(&mut self.film, pixels, rows, cancel, self.adaptive_threshold, |x, y| {
-            let mut sampler = Sampler::new(kind, y as u64 * size.0 as u64 + x as u64, sample_index, seed);
-            let ray = camera_ray(camera, size, x, y, &mut sampler);
-            tracer.radiance(scene, ray, &mut sampler)
-        });
+        // RGB or spectral, chosen once per pass: each is its own compiled loop.
+        let completed = if self.settings.spectral || scene.has_dispersion() {
+            self.add_pass(scene, camera, cancel, PathTracer::spectral_radiance)
+        } else {
+            self.add_pass(scene, camera, cancel, PathTracer::radiance)
+        };
         if completed {
             self.passes += 1;
+            let (pixels, rows) = (self.settings.sampled_pixels(), self.rows);
             // A stopped pixel stays stopped (its state no longer changes), so
             // once all that are sampled are, every later pass would be empty.
             let width = self.film.width as usize;

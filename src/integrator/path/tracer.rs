@@ -7,14 +7,18 @@
 
 use crate::color::Color;
 use crate::material::{ShadingPoint, Transport};
-use crate::math::{Frame as ShadingFrame, Ray, max_component, warp::power_heuristic};
+use crate::math::{Frame as ShadingFrame, Ray, warp::power_heuristic};
 use crate::sampler::Sampler;
 use crate::scene::Scene;
 use crate::settings::{IntegratorKind, RenderSettings};
+use crate::spectrum::{Radiance, SampledSpectrum, SampledWavelengths};
 use glam::DVec2;
 
 /// Bounces before Russian roulette may end a path.
 const ROULETTE_START: u32 = 3;
+
+/// Salt of the side stream a spectral path draws its wavelengths from.
+const WAVELENGTH_STREAM: u64 = 0x5eec_7a1f_a3e1_0000;
 
 /// Options of the per-sample tracer.
 #[derive(Clone, Copy, Debug)]
@@ -36,10 +40,33 @@ impl PathTracer {
         }
     }
 
-    /// Radiance arriving along `ray` (the Li of the rendering equation).
-    pub fn radiance(&self, scene: &Scene, mut ray: Ray, sampler: &mut Sampler) -> Color {
-        let mut radiance = Color::ZERO;
-        let mut throughput = Color::ONE;
+    /// Radiance arriving along `ray` (the Li of the rendering equation), in RGB.
+    pub fn radiance(&self, scene: &Scene, ray: Ray, sampler: &mut Sampler) -> Color {
+        self.trace::<Color>(scene, ray, sampler, &mut ())
+    }
+
+    /// The same by hero-wavelength spectral sampling: draws the path's
+    /// wavelengths (from a side stream of the pixel sample, so the path's
+    /// own draws are those of the RGB tracer), traces them, and returns the
+    /// film's RGB of the estimate.
+    pub fn spectral_radiance(&self, scene: &Scene, ray: Ray, sampler: &mut Sampler) -> Color {
+        let u_wavelength = sampler.side_stream(WAVELENGTH_STREAM).next_1d();
+        let mut wavelengths = SampledWavelengths::sample_uniform(u_wavelength);
+        self.radiance_at(scene, ray, sampler, &mut wavelengths)
+    }
+
+    /// Spectral radiance at given wavelengths, as film RGB (for measurements
+    /// at fixed wavelengths; [`spectral_radiance`](Self::spectral_radiance) samples them).
+    pub fn radiance_at(&self, scene: &Scene, ray: Ray, sampler: &mut Sampler, wavelengths: &mut SampledWavelengths) -> Color {
+        let radiance: SampledSpectrum = self.trace(scene, ray, sampler, wavelengths);
+        radiance.to_rgb(wavelengths)
+    }
+
+    /// The path tracer proper, over either colour type (see [`Radiance`]):
+    /// RGB values from materials and lights enter through `C::from_rgb`.
+    fn trace<C: Radiance>(&self, scene: &Scene, mut ray: Ray, sampler: &mut Sampler, wavelengths: &mut C::Wavelengths) -> C {
+        let mut radiance = C::ZERO;
+        let mut throughput = C::ONE;
         let mut specular_bounce = true;
         let mut previous_pdf = 0.0;
         let mut previous_point = ray.origin;
@@ -47,7 +74,7 @@ impl PathTracer {
 
         for bounce in 0.. {
             let Some(intersection) = scene.intersect(&ray, f64::INFINITY) else {
-                radiance += throughput * scene.background;
+                radiance += throughput * C::from_rgb(scene.background, wavelengths);
                 break;
             };
             let hit = intersection.hit;
@@ -67,7 +94,7 @@ impl PathTracer {
                         }
                         _ => 1.0,
                     };
-                    radiance += throughput * emitted * weight;
+                    radiance += throughput * C::from_rgb(emitted, wavelengths) * weight;
                 }
             }
             if !material.scatters() || bounce >= self.max_depth {
@@ -96,7 +123,8 @@ impl PathTracer {
                         let t_max = distance * (1.0 - 1e-9) - light.point_error.length();
                         if !scene.occluded(&shadow, t_max) {
                             let weight = power_heuristic(light.pdf, material.pdf(wo, wi));
-                            radiance += throughput * f * light.radiance * (weight / light.pdf);
+                            let f = C::from_rgb(f, wavelengths);
+                            radiance += throughput * f * C::from_rgb(light.radiance, wavelengths) * (weight / light.pdf);
                         }
                     }
                 }
@@ -106,11 +134,11 @@ impl PathTracer {
             let (uses_direction, uses_lobe) = material.sample_inputs();
             let u = if uses_direction { sampler.next_2d() } else { DVec2::ZERO };
             let u_lobe = if uses_lobe { sampler.next_1d() } else { 0.5 };
-            let Some(sample) = material.sample(wo, &at, u, u_lobe, Transport::Radiance) else {
+            let Some(sample) = C::sample_bsdf(material, wo, &at, u, u_lobe, Transport::Radiance, wavelengths) else {
                 break;
             };
-            throughput *= sample.weight;
-            if throughput == Color::ZERO {
+            throughput *= C::from_rgb(sample.weight, wavelengths);
+            if throughput == C::ZERO {
                 break;
             }
             specular_bounce = sample.specular;
@@ -120,7 +148,7 @@ impl PathTracer {
 
             // Russian roulette: survive with probability ~ throughput.
             if bounce + 1 >= ROULETTE_START {
-                let survival = max_component(throughput).min(0.95);
+                let survival = throughput.max_component().min(0.95);
                 if sampler.next_1d_independent() >= survival {
                     break;
                 }

@@ -200,6 +200,7 @@ impl Builder<'_> {
             Material::Glass {
                 ior: mtl.optical_density.map_or(1.5, f64::from),
                 tint: filter.unwrap_or(Color::ONE),
+                dispersion: None,
             }
         } else if glossy {
             used.extend(["Ks", "Ns"]);
