@@ -1,11 +1,12 @@
 //! Time on a CPU of one `denoise` call on a 512 × 512 Cornell frame, on a
 //! single worker thread: the thread's own run time from Linux's
 //! `/proc/thread-self/schedstat`, which, unlike wall time, does not count the
-//! time other processes on a shared machine hold the core. Prints the median
-//! of seven calls, and the same for the first-hit guide pass.
+//! time other processes on a shared machine hold the core (though it still
+//! counts the cache and memory bandwidth they share). Prints the minimum and
+//! the median of N calls (default 7), and the same for the first-hit guide pass.
 //!
-//! Run with `cargo run --release --example denoise_cost`; with the argument
-//! `once` it renders 1 sample per pixel and filters once, for
+//! Run with `cargo run --release --example denoise_cost [N]`; with the
+//! argument `once` it renders 1 sample per pixel and filters once, for
 //! `valgrind --tool=callgrind` (instruction counts).
 
 use prism::denoise::{DenoiseSettings, Guides, denoise};
@@ -15,7 +16,7 @@ use std::path::Path;
 use std::time::Duration;
 
 const SIZE: u32 = 512;
-const CALLS: usize = 7;
+const DEFAULT_CALLS: usize = 7;
 
 /// This thread's time on a CPU so far, if the kernel reports it.
 fn cpu_time() -> Option<Duration> {
@@ -23,19 +24,31 @@ fn cpu_time() -> Option<Duration> {
     text.split_whitespace().next()?.parse().ok().map(Duration::from_nanos)
 }
 
-fn median_cpu_ms(mut f: impl FnMut()) -> Option<f64> {
-    let mut times = Vec::with_capacity(CALLS);
-    for _ in 0..CALLS {
+/// The minimum and the median time on a CPU of `calls` calls of `f`, in ms.
+fn cpu_ms(calls: usize, mut f: impl FnMut()) -> Option<(f64, f64)> {
+    let mut times = Vec::with_capacity(calls);
+    for _ in 0..calls {
         let start = cpu_time()?;
         f();
         times.push((cpu_time()? - start).as_secs_f64() * 1e3);
     }
     times.sort_by(f64::total_cmp);
-    Some(times[CALLS / 2])
+    Some((*times.first()?, times[calls / 2]))
 }
 
 fn main() {
-    let once = std::env::args().nth(1).is_some_and(|a| a == "once");
+    let argument = std::env::args().nth(1);
+    let once = argument.as_deref() == Some("once");
+    let calls = match argument.as_deref().filter(|_| !once) {
+        Some(text) => match text.parse::<usize>() {
+            Ok(calls) if calls > 0 => calls,
+            _ => {
+                eprintln!("denoise_cost: the argument is `once` or a number of calls (≥ 1), not `{text}`");
+                std::process::exit(2);
+            }
+        },
+        None => DEFAULT_CALLS,
+    };
     let loaded = load_scene_file(Path::new("scenes/cornell.toml")).expect("scenes/cornell.toml loads");
     let settings = RenderSettings {
         width: SIZE,
@@ -58,15 +71,17 @@ fn main() {
             std::hint::black_box(denoise(&frame, &guides, &denoise_settings).expect("same size"));
             return;
         }
-        let filter = median_cpu_ms(|| {
+        let filter = cpu_ms(calls, || {
             std::hint::black_box(denoise(&frame, &guides, &denoise_settings).expect("same size"));
         });
-        let guide_pass = median_cpu_ms(|| {
+        let guide_pass = cpu_ms(calls.min(DEFAULT_CALLS), || {
             std::hint::black_box(Guides::first_hit(&loaded.scene, &loaded.camera, SIZE, SIZE));
         });
         match (filter, guide_pass) {
-            (Some(filter), Some(guide_pass)) => println!(
-                "{SIZE}x{SIZE}, one thread, median of {CALLS} (time on a CPU): denoise {filter:.1} ms, first-hit guides {guide_pass:.1} ms"
+            (Some((filter_min, filter_median)), Some((guide_min, guide_median))) => println!(
+                "{SIZE}x{SIZE}, one thread, time on a CPU: denoise min {filter_min:.1} ms, median {filter_median:.1} ms \
+                 ({calls} calls); first-hit guides min {guide_min:.1} ms, median {guide_median:.1} ms ({} calls)",
+                calls.min(DEFAULT_CALLS)
             ),
             _ => println!("no /proc/thread-self/schedstat: cannot measure time on a CPU here"),
         }

@@ -86,10 +86,12 @@ pub fn denoise(frame: &Frame, guides: &Guides, settings: &DenoiseSettings) -> Re
     // The radiance divided by the albedo (where there is one), and the
     // variance of its luminance.
     let mut color = [0; 3].map(|_| Plane::zeros(width, height));
+    let mut luminance_plane = Plane::zeros(width, height);
     let mut variance = Plane::zeros(width, height);
     for y in 0..height {
         let [r, g, b] = &mut color;
         let rows = [r.row_mut(y), g.row_mut(y), b.row_mut(y)];
+        let luminance_row = luminance_plane.row_mut(y);
         let variance_row = variance.row_mut(y);
         for x in 0..width {
             let i = y * width + x;
@@ -101,6 +103,7 @@ pub fn denoise(frame: &Frame, guides: &Guides, settings: &DenoiseSettings) -> Re
             for c in 0..3 {
                 rows[c][x] = demodulated[c];
             }
+            luminance_row[x] = luminance(demodulated);
             let deviation = match frame.noise.get(i).copied().filter(|e| e.is_finite()) {
                 Some(error) => error / luminance(divisor),
                 None => settings.assumed_relative_error * luminance(demodulated).max(LUMINANCE_FLOOR),
@@ -108,10 +111,15 @@ pub fn denoise(frame: &Frame, guides: &Guides, settings: &DenoiseSettings) -> Re
             variance_row[x] = deviation * deviation;
         }
     }
-    for plane in color.iter_mut().chain(std::iter::once(&mut variance)) {
+    for plane in color.iter_mut().chain([&mut luminance_plane, &mut variance]) {
         plane.replicate_edges();
     }
-    let filtered = atrous::filter(Signal { color, variance }, guides.planes(), settings);
+    let signal = Signal {
+        color,
+        luminance: luminance_plane,
+        variance,
+    };
+    let filtered = atrous::filter(signal, guides.planes(), settings);
     let mut pixels = Vec::with_capacity(width * height);
     let [r, g, b] = filtered.each_ref().map(|p| p.rows());
     for (((r, g), b), albedo) in r.zip(g).zip(b).zip(guides.albedo.chunks_exact(width)) {
