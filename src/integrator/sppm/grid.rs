@@ -233,7 +233,8 @@ mod tests {
                 .collect();
             grid.rebuild(|v| v.extend_from_slice(&points));
             let mut found = 0;
-            for _ in 0..2000 {
+            // Enough queries that even the sparsest build has hundreds inside spheres.
+            for _ in 0..8000 {
                 let query = next() * (scale * 1.2) - DVec3::splat(0.1 * scale);
                 let candidates: Vec<u32> = grid.candidates(query).map(|p| p.pixel).collect();
                 for p in &points {
