@@ -41,11 +41,10 @@ use super::{Integrator, Share};
 use crate::camera::Camera;
 use crate::color::Color;
 use crate::film::{Film, Frame};
-use crate::math::DVec3;
 use crate::sampler::{Sampler, SamplerKind};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
-use grid::VisiblePointGrid;
+use grid::{GridPoint, VisiblePointGrid};
 use photon::PhotonSources;
 use radius::{InitialRadius, global_area_scale};
 use rayon::prelude::*;
@@ -120,6 +119,11 @@ pub struct SppmIntegrator {
     height: u32,
     estimate: Estimate,
     tallies: Vec<PhotonTally>,
+    /// The camera pass's results, one per pixel, kept between iterations so
+    /// that each pass overwrites them instead of allocating.
+    samples: Vec<CameraSample>,
+    /// The grid over the gather spheres, rebuilt in place every iteration.
+    grid: VisiblePointGrid,
     /// Index of the first iteration (a farm share may start past 0).
     first_iteration: u32,
     iterations: u32,
@@ -155,6 +159,8 @@ impl SppmIntegrator {
             height: settings.height,
             estimate,
             tallies: (0..count).map(|_| PhotonTally::default()).collect(),
+            samples: vec![CameraSample::SKIPPED; count],
+            grid: VisiblePointGrid::default(),
             first_iteration: share.samples.start,
             iterations: 0,
             rejected: 0,
@@ -198,42 +204,43 @@ impl SppmIntegrator {
     }
 
     /// Step 1: one camera path per pixel (and a few more for the emitted
-    /// term) from the iteration's sample streams.
-    fn camera_pass(&self, scene: &Scene, camera: &Camera, cancel: &AtomicBool) -> Vec<CameraSample> {
+    /// term) from the iteration's sample streams, into `samples` (one per pixel).
+    fn camera_pass(&self, scene: &Scene, camera: &Camera, cancel: &AtomicBool, samples: &mut [CameraSample]) {
         let (kind, seed, iteration, max_depth) = (self.sampler, self.seed, self.iteration(), self.max_depth);
         let size = (self.width, self.height);
         let sampled = self.settings.sampled_pixels();
-        (0..self.width as usize * self.height as usize)
-            .into_par_iter()
-            .map(|index| {
-                let (x, y) = (index as u32 % size.0, index as u32 / size.0);
-                if cancel.load(Ordering::Relaxed) || !sampled.contains(x, y) {
-                    return CameraSample::SKIPPED;
-                }
-                let mut sampler = Sampler::new(kind, index as u64, iteration, seed);
+        let sample_pixel = |index: usize| {
+            let (x, y) = (index as u32 % size.0, index as u32 / size.0);
+            if cancel.load(Ordering::Relaxed) || !sampled.contains(x, y) {
+                return CameraSample::SKIPPED;
+            }
+            let mut sampler = Sampler::new(kind, index as u64, iteration, seed);
+            let ray = camera_ray(camera, size, x, y, &mut sampler);
+            let path = trace_camera_path(scene, ray, &mut sampler, max_depth);
+            // The emitted term: this path and a few more, from their own
+            // Sobol' stream so each stream stays stratified over iterations.
+            let mut emitted = path.emitted;
+            for extra in 0..EMISSION_SAMPLES - 1 {
+                let mut sampler = Sampler::new(
+                    kind,
+                    index as u64,
+                    iteration * (EMISSION_SAMPLES - 1) + extra,
+                    seed ^ EMISSION_SEED,
+                );
                 let ray = camera_ray(camera, size, x, y, &mut sampler);
-                let path = trace_camera_path(scene, ray, &mut sampler, max_depth);
-                // The emitted term: this path and a few more, from their own
-                // Sobol' stream so each stream stays stratified over iterations.
-                let mut emitted = path.emitted;
-                for extra in 0..EMISSION_SAMPLES - 1 {
-                    let mut sampler = Sampler::new(
-                        kind,
-                        index as u64,
-                        iteration * (EMISSION_SAMPLES - 1) + extra,
-                        seed ^ EMISSION_SEED,
-                    );
-                    let ray = camera_ray(camera, size, x, y, &mut sampler);
-                    emitted += trace_camera_path(scene, ray, &mut sampler, max_depth).emitted;
-                }
-                let emitted = emitted / EMISSION_SAMPLES as f64;
-                CameraSample {
-                    sampled: true,
-                    visible: path.visible_point.filter(|vp| vp.throughput.is_finite()),
-                    emitted: emitted.is_finite().then_some(emitted),
-                }
-            })
-            .collect()
+                emitted += trace_camera_path(scene, ray, &mut sampler, max_depth).emitted;
+            }
+            let emitted = emitted / EMISSION_SAMPLES as f64;
+            CameraSample {
+                sampled: true,
+                visible: path.visible_point.filter(|vp| vp.throughput.is_finite()),
+                emitted: emitted.is_finite().then_some(emitted),
+            }
+        };
+        samples
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(index, slot)| *slot = sample_pixel(index));
     }
 
     /// Step 1, continued: each pixel's gather radius for this iteration. The
@@ -279,15 +286,8 @@ impl SppmIntegrator {
 
     /// Step 3: traces this iteration's photons in parallel, adding to the
     /// tallies of the visible points they land near. Returns false if cancelled.
-    fn photon_pass(
-        &self,
-        scene: &Scene,
-        sources: &PhotonSources,
-        visible: &[CameraSample],
-        radii: &[f64],
-        grid: &VisiblePointGrid,
-        cancel: &AtomicBool,
-    ) -> bool {
+    fn photon_pass(&self, scene: &Scene, sources: &PhotonSources, visible: &[CameraSample], cancel: &AtomicBool) -> bool {
+        let grid = &self.grid;
         let (kind, iteration, max_depth) = (self.sampler, self.iteration(), self.max_depth);
         let seed = self.seed ^ PHOTON_SEED;
         let inverse_unit = 1.0 / flux_unit(sources);
@@ -303,17 +303,17 @@ impl SppmIntegrator {
                     return;
                 };
                 photon::trace(scene, emitted, &mut sampler, max_depth, |hit, towards_light, flux| {
-                    for &pixel in grid.candidates(hit.point) {
-                        let Some(vp) = &visible[pixel as usize].visible else {
-                            continue;
-                        };
-                        let radius = radii[pixel as usize];
-                        if (vp.point - hit.point).length_squared() > radius * radius
-                            || vp.geometric_normal.dot(hit.geometric_normal) < NORMAL_AGREEMENT
-                            || towards_light.dot(vp.geometric_normal).signum() != vp.side()
+                    for candidate in grid.candidates(hit.point) {
+                        if (candidate.center - hit.point).length_squared() > candidate.radius_squared
+                            || candidate.normal.dot(hit.geometric_normal) < NORMAL_AGREEMENT
+                            || towards_light.dot(candidate.normal).signum() != f64::from(candidate.side)
                         {
                             continue;
                         }
+                        let pixel = candidate.pixel;
+                        let Some(vp) = &visible[pixel as usize].visible else {
+                            continue;
+                        };
                         let material = &scene.materials[vp.material as usize];
                         let f = material.eval(vp.wo, vp.frame.to_local(towards_light), &vp.at);
                         self.tallies[pixel as usize].add(flux * f, inverse_unit);
@@ -384,26 +384,42 @@ impl SppmIntegrator {
 impl Integrator for SppmIntegrator {
     fn render_pass(&mut self, scene: &Scene, camera: &Camera, cancel: &AtomicBool) -> bool {
         let start = Instant::now();
-        let visible = self.camera_pass(scene, camera, cancel);
+        let mut visible = std::mem::take(&mut self.samples);
+        self.camera_pass(scene, camera, cancel, &mut visible);
         if cancel.load(Ordering::Relaxed) {
+            self.samples = visible;
             return false;
         }
         // Step 2: the grid over the gather spheres.
         let radii = self.radii_for_iteration(camera, &visible);
-        let points: Vec<(u32, DVec3, f64)> = visible
-            .par_iter()
-            .enumerate()
-            .filter_map(|(index, sample)| sample.visible.as_ref().map(|vp| (index as u32, vp.point, radii[index])))
-            .collect();
-        let grid = VisiblePointGrid::build(&points);
+        self.grid.rebuild(|points| {
+            points.extend(
+                visible
+                    .iter()
+                    .zip(&radii)
+                    .enumerate()
+                    .filter_map(|(pixel, (sample, &radius))| {
+                        sample.visible.as_ref().map(|vp| GridPoint {
+                            center: vp.point,
+                            radius_squared: radius * radius,
+                            normal: vp.geometric_normal,
+                            side: vp.side() as f32,
+                            pixel: pixel as u32,
+                        })
+                    }),
+            )
+        });
         let photons_start = Instant::now();
         let sources = PhotonSources::new(scene);
-        if !self.photon_pass(scene, &sources, &visible, &radii, &grid, cancel) {
+        let completed = self.photon_pass(scene, &sources, &visible, cancel);
+        if !completed {
             self.clear_tallies();
+            self.samples = visible;
             return false;
         }
         self.photon_time += photons_start.elapsed();
         self.update_estimate(&sources, &visible, radii);
+        self.samples = visible;
         self.iterations += 1;
         self.total_time += start.elapsed();
         true
