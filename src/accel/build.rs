@@ -4,9 +4,10 @@
 //! (`bvh.rs` collapses it into four-wide nodes).
 //!
 //! Items are binned along all three axes at once and the plane of least
-//! SAH cost C = C_trav + (A_L N_L + A_R N_R) / A (in units of one primitive
-//! test) is taken; a range becomes a leaf when that is no cheaper than
-//! testing its primitives and it is small enough for its kind. Leaves never
+//! SAH cost C = C_trav + (A_L ⌈N_L/4⌉ + A_R ⌈N_R/4⌉) / A (in units of one
+//! leaf test, which tests up to four triangles at once) is taken; a range
+//! becomes a leaf when that is no cheaper than testing its primitives and
+//! it is small enough for its kind. Leaves never
 //! mix primitive kinds (triangles and other shapes are stored apart), and
 //! subtrees deeper than [`MAX_SAH_DEPTH`] fall back to median splits, which
 //! bounds the depth for any input.
@@ -26,8 +27,11 @@ use wide::f32x4;
 const BIN_COUNT: usize = 16;
 /// Subtrees larger than this are built on two threads.
 const PARALLEL_THRESHOLD: usize = 8192;
-/// Cost of one traversal step in units of one primitive test: a four-wide
-/// node tests four boxes at once, about what one triangle test costs.
+/// Cost of one traversal step in units of one leaf test. A four-wide node
+/// tests four boxes at once and a triangle leaf tests its up to four
+/// triangles at once, at about the same cost, so a leaf's cost is its
+/// number of *blocks* (primitives tested together; see [`blocks`]), and
+/// splitting a range that fits one block never pays: leaves come out full.
 const TRAVERSAL_COST: f32 = 1.0;
 /// Depth beyond which splits are made at the object median.
 const MAX_SAH_DEPTH: usize = 48;
@@ -247,7 +251,9 @@ fn choose_split(items: &mut [BuildItem], range: &Range, max_leaf_size: &[usize])
     }
     let first_kind = items[0].kind;
     let one_kind = items.iter().all(|item| item.kind == first_kind);
-    let leaf_allowed = one_kind && count <= max_leaf_size.get(first_kind as usize).copied().unwrap_or(1);
+    // Primitives of the (first) kind tested together: the SAH counts blocks.
+    let block = max_leaf_size.get(first_kind as usize).copied().unwrap_or(1).max(1) as u32;
+    let leaf_allowed = one_kind && count <= block as usize;
     if !one_kind && count <= 2 * MAX_LEAF_SIZE {
         // Small and mixed: separate the kinds; each side then may become a leaf.
         return Some(partition(items, range, |item| item.kind == first_kind));
@@ -307,7 +313,7 @@ fn choose_split(items: &mut [BuildItem], range: &Range, max_leaf_size: &[usize])
             if counts[axis][plane] > 0 {
                 right_bounds = right_bounds.union(&bins[axis][plane]);
                 right_count += counts[axis][plane];
-                cost_so_far = right_bounds.half_area() * right_count as f32;
+                cost_so_far = right_bounds.half_area() * blocks(right_count, block);
             }
             right_cost[plane] = cost_so_far;
         }
@@ -322,7 +328,7 @@ fn choose_split(items: &mut [BuildItem], range: &Range, max_leaf_size: &[usize])
             if left_count as usize == count {
                 break;
             }
-            let cost = left_bounds.half_area() * left_count as f32 + right_cost[plane];
+            let cost = left_bounds.half_area() * blocks(left_count, block) + right_cost[plane];
             if cost < best.0 {
                 best = (cost, axis, plane);
             }
@@ -330,13 +336,20 @@ fn choose_split(items: &mut [BuildItem], range: &Range, max_leaf_size: &[usize])
     }
     let (best_cost, axis, plane) = best;
     let split_cost = TRAVERSAL_COST + best_cost / range.bounds.half_area().max(f32::MIN_POSITIVE);
-    if leaf_allowed && split_cost >= count as f32 {
+    if leaf_allowed && split_cost >= blocks(count as u32, block) {
         return None;
     }
     if !best_cost.is_finite() {
         return Some(median_split(items, range, extent));
     }
     Some(partition(items, range, |item| (bins_of(item)[axis] as usize) < plane))
+}
+
+/// Leaf tests `count` primitives need, `block` at a time (Embree's
+/// builders count the same way).
+#[inline(always)]
+fn blocks(count: u32, block: u32) -> f32 {
+    count.div_ceil(block) as f32
 }
 
 /// Splits at the median centroid along the widest axis.

@@ -96,6 +96,18 @@ pub struct Leaf {
     pub count: u32,
 }
 
+impl Leaf {
+    /// The leaf a child reference with `LEAF_BIT` set stands for.
+    #[inline(always)]
+    fn from_reference(reference: u32) -> Self {
+        Leaf {
+            kind: ((reference >> KIND_SHIFT) & 1) as u8,
+            first: reference & FIRST_MASK,
+            count: ((reference >> COUNT_SHIFT) & 3) + 1,
+        }
+    }
+}
+
 /// A primitive to build over: its exact bounds and its kind.
 #[derive(Clone, Copy, Debug)]
 pub struct BuildPrimitive {
@@ -185,6 +197,21 @@ impl Bvh {
     /// Number of leaves.
     pub fn leaf_count(&self) -> usize {
         self.leaf_count
+    }
+
+    /// The leaves holding primitives of `kind`, in the order of their
+    /// first primitive: they cover that kind's leaf-ordered list once.
+    pub fn leaves(&self, kind: u8) -> Vec<Leaf> {
+        let mut leaves: Vec<Leaf> = self
+            .nodes
+            .iter()
+            .flat_map(|node| node.children)
+            .filter(|&child| child != EMPTY_CHILD && child & LEAF_BIT != 0)
+            .map(Leaf::from_reference)
+            .filter(|leaf| leaf.kind == kind)
+            .collect();
+        leaves.sort_unstable_by_key(|leaf| leaf.first);
+        leaves
     }
 
     /// Bytes the nodes occupy.
@@ -288,12 +315,7 @@ impl Bvh {
                     }
                 }
             } else {
-                let leaf = Leaf {
-                    kind: ((current >> KIND_SHIFT) & 1) as u8,
-                    first: current & FIRST_MASK,
-                    count: ((current >> COUNT_SHIFT) & 3) + 1,
-                };
-                if visit(leaf, t_max) {
+                if visit(Leaf::from_reference(current), t_max) {
                     return;
                 }
                 limit = traversal_limit(*t_max);
@@ -474,10 +496,11 @@ impl Collapser<'_> {
         self.depth = self.depth.max(depth);
         // Open the binary subtree: repeatedly replace the interior child of
         // largest area by its two children, up to four children.
-        let mut children: Vec<usize> = match self.binary[index].content {
-            BinaryContent::Leaf { .. } => vec![index],
-            BinaryContent::Interior { right } => vec![index + 1, right as usize],
-        };
+        let mut children = ArrayVec::<usize, WIDTH>::new();
+        match self.binary[index].content {
+            BinaryContent::Leaf { .. } => children.push(index),
+            BinaryContent::Interior { right } => children.extend([index + 1, right as usize]),
+        }
         while children.len() < WIDTH {
             let widest = children
                 .iter()

@@ -37,12 +37,13 @@ pub struct TriangleHit {
 #[derive(Clone, Copy, Debug)]
 pub struct TriangleRay {
     /// Source axes of the permuted x, y and z.
-    axes: [usize; 3],
+    pub(crate) axes: [usize; 3],
     /// The origin, permuted.
-    origin: [f64; 3],
-    shear_x: f64,
-    shear_y: f64,
-    shear_z: f64,
+    pub(crate) origin: [f64; 3],
+    /// −d_x/d_z, −d_y/d_z and 1/d_z of the permuted direction.
+    pub(crate) shear_x: f64,
+    pub(crate) shear_y: f64,
+    pub(crate) shear_z: f64,
 }
 
 impl TriangleRay {

@@ -110,7 +110,12 @@ impl Scene {
         // revolution test costs several box tests, which can cull it.
         let (bvh, orders) = Bvh::build_with_leaf_sizes(&build_primitives, [4, 1]);
         let triangle_count = triangles.len() as u32;
-        let triangles = Triangles::new(&triangles, &orders[TRIANGLE_LEAF as usize], anchors);
+        let triangles = Triangles::new(
+            &triangles,
+            &orders[TRIANGLE_LEAF as usize],
+            &bvh.leaves(TRIANGLE_LEAF),
+            anchors,
+        );
         let mut slots: Vec<Option<Primitive>> = shapes.into_iter().map(Some).collect();
         let shapes: Vec<Primitive> = orders[SHAPE_LEAF as usize]
             .iter()
