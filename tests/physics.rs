@@ -2,7 +2,7 @@
 //! known exactly, and estimators that must agree in the mean.
 
 mod common;
-use common::{Job, mean_and_error, render, scene, shipped_scene};
+use common::{Job, assert_estimators_agree, mean_and_error, render, scene, shipped_scene};
 use prism::render::IntegratorKind;
 
 /// A uniformly emitting enclosure (radiance 1, seen from inside, so two-sided)
@@ -96,45 +96,6 @@ fn light_sampling_and_bsdf_sampling_agree_on_cornell() {
     };
     // Teeth: every channel well above zero, errors under 10% of the mean.
     assert_estimators_agree(&loaded, job, 0.01, 0.1);
-}
-
-/// Runs NEE+MIS and BSDF-only path tracing over 8 seeds each and checks
-/// that their per-channel means agree within three combined standard
-/// errors; `min_mean` and `max_relative_error` make sure the comparison is
-/// sharp enough to mean something.
-fn assert_estimators_agree(loaded: &prism::scene::LoadedScene, job: Job, min_mean: f64, max_relative_error: f64) {
-    let (nee, nee_error) = mean_and_error(
-        loaded,
-        &Job {
-            integrator: IntegratorKind::PathTracing,
-            ..job
-        },
-        8,
-    );
-    let (bsdf, bsdf_error) = mean_and_error(
-        loaded,
-        &Job {
-            integrator: IntegratorKind::BsdfOnly,
-            ..job
-        },
-        8,
-    );
-    eprintln!("NEE {nee:?} ± {nee_error:?}, BSDF {bsdf:?} ± {bsdf_error:?}");
-    for c in 0..3 {
-        let combined = (nee_error[c].powi(2) + bsdf_error[c].powi(2)).sqrt();
-        assert!(
-            (nee[c] - bsdf[c]).abs() < 3.0 * combined,
-            "channel {c}: NEE {} ± {}, BSDF {} ± {}",
-            nee[c],
-            nee_error[c],
-            bsdf[c],
-            bsdf_error[c]
-        );
-        assert!(
-            nee[c] > min_mean && combined < max_relative_error * nee[c],
-            "channel {c}: {nee:?} ± {combined}"
-        );
-    }
 }
 
 /// Light sampling must lower variance where it should: on the Cornell box

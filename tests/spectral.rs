@@ -4,7 +4,7 @@
 //! two path-tracing estimators agreeing, and determinism across threads.
 
 mod common;
-use common::{Job, mean_and_error, render, scene, shipped_scene};
+use common::{Job, assert_estimators_agree, render, scene, shipped_scene};
 use prism::render::IntegratorKind;
 use prism::spectrum::sensor::{D65_CHROMATICITY, chromaticity};
 
@@ -230,36 +230,8 @@ fn spectral_light_sampling_and_bsdf_sampling_agree() {
         spectral: true,
         ..Job::default()
     };
-    let (nee, nee_error) = mean_and_error(
-        &loaded,
-        &Job {
-            integrator: IntegratorKind::PathTracing,
-            ..job
-        },
-        8,
-    );
-    let (bsdf, bsdf_error) = mean_and_error(
-        &loaded,
-        &Job {
-            integrator: IntegratorKind::BsdfOnly,
-            ..job
-        },
-        8,
-    );
-    eprintln!("NEE {nee:?} ± {nee_error:?}, BSDF {bsdf:?} ± {bsdf_error:?}");
-    for c in 0..3 {
-        let combined = (nee_error[c].powi(2) + bsdf_error[c].powi(2)).sqrt();
-        assert!(
-            (nee[c] - bsdf[c]).abs() < 3.0 * combined,
-            "channel {c}: NEE {} ± {}, BSDF {} ± {}",
-            nee[c],
-            nee_error[c],
-            bsdf[c],
-            bsdf_error[c]
-        );
-        // Teeth: the comparison is sharp (errors under 10% of the mean).
-        assert!(nee[c] > 0.01 && combined < 0.1 * nee[c], "channel {c}: {nee:?} ± {combined}");
-    }
+    // Teeth: every channel well above zero, errors under 10% of the mean.
+    assert_estimators_agree(&loaded, job, 0.01, 0.1);
 }
 
 /// Spectral path tracing draws its wavelengths from the pixel sample's own

@@ -96,3 +96,42 @@ impl Clone for Job {
     }
 }
 impl Copy for Job {}
+
+/// Runs NEE+MIS and BSDF-only path tracing over 8 seeds each and checks
+/// that their per-channel means agree within three combined standard
+/// errors; `min_mean` and `max_relative_error` make sure the comparison is
+/// sharp enough to mean something.
+pub fn assert_estimators_agree(loaded: &LoadedScene, job: Job, min_mean: f64, max_relative_error: f64) {
+    let (nee, nee_error) = mean_and_error(
+        loaded,
+        &Job {
+            integrator: IntegratorKind::PathTracing,
+            ..job
+        },
+        8,
+    );
+    let (bsdf, bsdf_error) = mean_and_error(
+        loaded,
+        &Job {
+            integrator: IntegratorKind::BsdfOnly,
+            ..job
+        },
+        8,
+    );
+    eprintln!("NEE {nee:?} ± {nee_error:?}, BSDF {bsdf:?} ± {bsdf_error:?}");
+    for c in 0..3 {
+        let combined = (nee_error[c].powi(2) + bsdf_error[c].powi(2)).sqrt();
+        assert!(
+            (nee[c] - bsdf[c]).abs() < 3.0 * combined,
+            "channel {c}: NEE {} ± {}, BSDF {} ± {}",
+            nee[c],
+            nee_error[c],
+            bsdf[c],
+            bsdf_error[c]
+        );
+        assert!(
+            nee[c] > min_mean && combined < max_relative_error * nee[c],
+            "channel {c}: {nee:?} ± {combined}"
+        );
+    }
+}
