@@ -3,7 +3,9 @@
 # binary under Xvfb with openbox (for focus), drives it with xdotool and
 # writes screenshots/viewer.png (the default scene rendering),
 # viewer-inspect.png (1:1 zoom with the pixel readout), viewer-denoise.png
-# (raw beside denoised) and viewer-region.png (a region render).
+# (raw beside denoised) and viewer-region.png (a region render); then opens
+# scenes/prism.toml (spectral SPPM) and writes viewer-prism-early.png (after
+# 4 s) and viewer-prism.png (after 40 s).
 #
 # The click positions are those of the side panel's controls relative to the
 # window's top-left corner (xdotool mousemove --window); if the panel's layout
@@ -55,4 +57,19 @@ xvfb-run -a -s "-screen 0 1280x800x24" bash -c '
     point 158 283
     shot viewer-region.png 15
 '
-echo "gui_screenshots: wrote $shots/viewer.png viewer-inspect.png viewer-denoise.png viewer-region.png"
+xvfb-run -a -s "-screen 0 1280x800x24" bash -c '
+    set -euo pipefail
+    openbox >/dev/null 2>&1 &
+    openbox_pid=$!
+    sleep 1
+    "$bin" view scenes/prism.toml 2>/dev/null &
+    viewer=$!
+    trap "kill $viewer $openbox_pid 2>/dev/null || true" EXIT
+    window=$(xdotool search --sync --onlyvisible --name "^Prism" | head -1)
+    xdotool mousemove --window "$window" 158 283
+    sleep 4
+    import -window "$window" "$shots/viewer-prism-early.png"
+    sleep 36
+    import -window "$window" "$shots/viewer-prism.png"
+'
+echo "gui_screenshots: wrote $shots/viewer.png viewer-inspect.png viewer-denoise.png viewer-region.png viewer-prism-early.png viewer-prism.png"

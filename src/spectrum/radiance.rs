@@ -10,12 +10,24 @@ use super::uplift::spectrum_of_rgb;
 use super::{SampledSpectrum, SampledWavelengths, WAVELENGTHS};
 use crate::color::Color;
 use crate::material::{BsdfSample, Material, ShadingPoint, Transport};
+use crate::sampler::Sampler;
 use glam::{DVec2, DVec3};
-use std::ops::{Add, AddAssign, DivAssign, Mul, MulAssign};
+use std::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign};
+
+/// Salt of the side stream a spectral path draws its wavelengths from.
+const WAVELENGTH_STREAM: u64 = 0x5eec_7a1f_a3e1_0000;
 
 /// Radiance, throughput or a BSDF value as a path carries it.
 pub trait Radiance:
-    Copy + PartialEq + Add<Output = Self> + AddAssign + Mul<Output = Self> + MulAssign + Mul<f64, Output = Self> + DivAssign<f64>
+    Copy
+    + PartialEq
+    + Add<Output = Self>
+    + AddAssign
+    + Mul<Output = Self>
+    + MulAssign
+    + Mul<f64, Output = Self>
+    + Div<f64, Output = Self>
+    + DivAssign<f64>
 {
     /// What the path carries besides (its sampled wavelengths, or nothing).
     type Wavelengths: Copy;
@@ -27,8 +39,20 @@ pub trait Radiance:
     /// An RGB quantity (reflectance, BSDF value, emission) in this form.
     fn from_rgb(rgb: Color, wavelengths: &Self::Wavelengths) -> Self;
 
+    /// Draws what a new path carries besides (its wavelengths) from a side
+    /// stream of `sampler`, so the path's own draws are those of an RGB path.
+    fn sample_wavelengths(sampler: &Sampler) -> Self::Wavelengths;
+
+    /// Whether the path was narrowed to its hero wavelength (it crossed a
+    /// dispersive interface), so its throughput is valid at that λ only.
+    fn is_dispersed(wavelengths: &Self::Wavelengths) -> bool;
+
     /// The largest component (for Russian roulette).
     fn max_component(self) -> f64;
+
+    /// A brightness for ratios (photon Russian roulette): luminance in RGB,
+    /// the mean over the lanes for a spectrum.
+    fn brightness(self) -> f64;
 
     /// The film's RGB of this estimate.
     fn to_rgb(self, wavelengths: &Self::Wavelengths) -> Color;
@@ -57,8 +81,21 @@ impl Radiance for Color {
     }
 
     #[inline(always)]
+    fn sample_wavelengths(_: &Sampler) {}
+
+    #[inline(always)]
+    fn is_dispersed(_: &()) -> bool {
+        false
+    }
+
+    #[inline(always)]
     fn max_component(self) -> f64 {
         crate::math::max_component(self)
+    }
+
+    #[inline(always)]
+    fn brightness(self) -> f64 {
+        crate::color::luminance(self)
     }
 
     #[inline(always)]
@@ -90,9 +127,22 @@ impl Radiance for SampledSpectrum {
         spectrum_of_rgb(rgb, wavelengths)
     }
 
+    fn sample_wavelengths(sampler: &Sampler) -> SampledWavelengths {
+        SampledWavelengths::sample_uniform(sampler.side_stream(WAVELENGTH_STREAM).next_1d())
+    }
+
+    fn is_dispersed(wavelengths: &SampledWavelengths) -> bool {
+        wavelengths.secondary_terminated()
+    }
+
     #[inline]
     fn max_component(self) -> f64 {
         self.max_element()
+    }
+
+    #[inline]
+    fn brightness(self) -> f64 {
+        self.element_sum() / WAVELENGTHS as f64
     }
 
     /// XYZ = (1/N) Σᵢ L(λᵢ) (x̄, ȳ, z̄)(λᵢ) / p(λᵢ) / ∫ȳ over the live lanes

@@ -152,9 +152,15 @@ fn ui_render(app: &mut ViewerApp, ui: &mut Ui) {
             }
         });
 
-    ui.checkbox(&mut app.settings.spectral, "Spectral").on_hover_text(
-        "Carry 4 sampled wavelengths per path instead of RGB (path tracing; scenes with dispersive glass are always spectral)",
-    );
+    // A dispersive glass makes the render spectral whatever the setting, so
+    // the box shows that instead of a choice it would not honour.
+    if app.scene.as_ref().is_some_and(|scene| scene.has_dispersion()) {
+        ui.add_enabled(false, egui::Checkbox::new(&mut true, "Spectral (dispersive glass)"))
+            .on_disabled_hover_text("This scene has a dispersive glass, so it is always rendered spectrally");
+    } else {
+        ui.checkbox(&mut app.settings.spectral, "Spectral")
+            .on_hover_text("Carry 4 sampled wavelengths per path and photon instead of RGB (path tracing and SPPM)");
+    }
 
     let sppm = app.settings.integrator == IntegratorKind::Sppm;
     let mut unlimited = app.settings.samples_per_pixel.is_none();

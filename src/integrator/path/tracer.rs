@@ -17,9 +17,6 @@ use glam::DVec2;
 /// Bounces before Russian roulette may end a path.
 const ROULETTE_START: u32 = 3;
 
-/// Salt of the side stream a spectral path draws its wavelengths from.
-const WAVELENGTH_STREAM: u64 = 0x5eec_7a1f_a3e1_0000;
-
 /// Options of the per-sample tracer.
 #[derive(Clone, Copy, Debug)]
 pub struct PathTracer {
@@ -50,8 +47,7 @@ impl PathTracer {
     /// own draws are those of the RGB tracer), traces them, and returns the
     /// film's RGB of the estimate.
     pub fn spectral_radiance(&self, scene: &Scene, ray: Ray, sampler: &mut Sampler) -> Color {
-        let u_wavelength = sampler.side_stream(WAVELENGTH_STREAM).next_1d();
-        let mut wavelengths = SampledWavelengths::sample_uniform(u_wavelength);
+        let mut wavelengths = SampledSpectrum::sample_wavelengths(sampler);
         self.radiance_at(scene, ray, sampler, &mut wavelengths)
     }
 

@@ -24,8 +24,14 @@
 //! source of photons from every direction ([`photon::PhotonSources`]).
 //!
 //! Every sample is seeded by (pixel or photon index, iteration, seed), so the
-//! image does not depend on which thread traced what, up to the summation
-//! order of the lock-free flux tallies.
+//! image does not depend on which thread traced what; the lock-free flux
+//! tallies add in fixed point, so their order does not matter either.
+//!
+//! Spectral mode (asked for, or forced by dispersive glass) is the same
+//! algorithm over [`SampledSpectrum`]: every camera path and every photon
+//! draws its own hero wavelengths, and a photon's contribution at a visible
+//! point (flux times the visible point's BSDF, both at the photon's
+//! wavelengths) enters the pixel's tally as film RGB.
 
 pub mod grid;
 pub mod photon;
@@ -44,6 +50,7 @@ use crate::film::{Film, Frame};
 use crate::sampler::{Sampler, SamplerKind};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
+use crate::spectrum::{Radiance, SampledSpectrum};
 use grid::{GridPoint, VisiblePointGrid};
 use photon::PhotonSources;
 use radius::{InitialRadius, global_area_scale};
@@ -205,7 +212,7 @@ impl SppmIntegrator {
 
     /// Step 1: one camera path per pixel (and a few more for the emitted
     /// term) from the iteration's sample streams, into `samples` (one per pixel).
-    fn camera_pass(&self, scene: &Scene, camera: &Camera, cancel: &AtomicBool, samples: &mut [CameraSample]) {
+    fn camera_pass<C: Radiance>(&self, scene: &Scene, camera: &Camera, cancel: &AtomicBool, samples: &mut [CameraSample]) {
         let (kind, seed, iteration, max_depth) = (self.sampler, self.seed, self.iteration(), self.max_depth);
         let size = (self.width, self.height);
         let sampled = self.settings.sampled_pixels();
@@ -216,7 +223,7 @@ impl SppmIntegrator {
             }
             let mut sampler = Sampler::new(kind, index as u64, iteration, seed);
             let ray = camera_ray(camera, size, x, y, &mut sampler);
-            let path = trace_camera_path(scene, ray, &mut sampler, max_depth);
+            let path = trace_camera_path::<C>(scene, ray, &mut sampler, max_depth);
             // The emitted term: this path and a few more, from their own
             // Sobol' stream so each stream stays stratified over iterations.
             let mut emitted = path.emitted;
@@ -228,7 +235,7 @@ impl SppmIntegrator {
                     seed ^ EMISSION_SEED,
                 );
                 let ray = camera_ray(camera, size, x, y, &mut sampler);
-                emitted += trace_camera_path(scene, ray, &mut sampler, max_depth).emitted;
+                emitted += trace_camera_path::<C>(scene, ray, &mut sampler, max_depth).emitted;
             }
             let emitted = emitted / EMISSION_SAMPLES as f64;
             CameraSample {
@@ -286,7 +293,13 @@ impl SppmIntegrator {
 
     /// Step 3: traces this iteration's photons in parallel, adding to the
     /// tallies of the visible points they land near. Returns false if cancelled.
-    fn photon_pass(&self, scene: &Scene, sources: &PhotonSources, visible: &[CameraSample], cancel: &AtomicBool) -> bool {
+    fn photon_pass<C: Radiance>(
+        &self,
+        scene: &Scene,
+        sources: &PhotonSources,
+        visible: &[CameraSample],
+        cancel: &AtomicBool,
+    ) -> bool {
         let grid = &self.grid;
         let (kind, iteration, max_depth) = (self.sampler, self.iteration(), self.max_depth);
         let seed = self.seed ^ PHOTON_SEED;
@@ -299,26 +312,33 @@ impl SppmIntegrator {
                     return;
                 }
                 let mut sampler = Sampler::new(kind, index as u64, iteration, seed);
-                let Some(emitted) = sources.emit(scene, &mut sampler) else {
+                let Some(emitted) = sources.emit::<C>(scene, &mut sampler) else {
                     return;
                 };
-                photon::trace(scene, emitted, &mut sampler, max_depth, |hit, towards_light, flux| {
-                    for candidate in grid.candidates(hit.point) {
-                        if (candidate.center - hit.point).length_squared() > candidate.radius_squared
-                            || candidate.normal.dot(hit.geometric_normal) < NORMAL_AGREEMENT
-                            || towards_light.dot(candidate.normal).signum() != f64::from(candidate.side)
-                        {
-                            continue;
+                photon::trace(
+                    scene,
+                    emitted,
+                    &mut sampler,
+                    max_depth,
+                    |hit, towards_light, flux, wavelengths| {
+                        for candidate in grid.candidates(hit.point) {
+                            if (candidate.center - hit.point).length_squared() > candidate.radius_squared
+                                || candidate.normal.dot(hit.geometric_normal) < NORMAL_AGREEMENT
+                                || towards_light.dot(candidate.normal).signum() != f64::from(candidate.side)
+                            {
+                                continue;
+                            }
+                            let pixel = candidate.pixel;
+                            let Some(vp) = &visible[pixel as usize].visible else {
+                                continue;
+                            };
+                            let material = &scene.materials[vp.material as usize];
+                            let f = material.eval(vp.wo, vp.frame.to_local(towards_light), &vp.at);
+                            let contribution = (flux * C::from_rgb(f, wavelengths)).to_rgb(wavelengths);
+                            self.tallies[pixel as usize].add(contribution, inverse_unit);
                         }
-                        let pixel = candidate.pixel;
-                        let Some(vp) = &visible[pixel as usize].visible else {
-                            continue;
-                        };
-                        let material = &scene.materials[vp.material as usize];
-                        let f = material.eval(vp.wo, vp.frame.to_local(towards_light), &vp.at);
-                        self.tallies[pixel as usize].add(flux * f, inverse_unit);
-                    }
-                });
+                    },
+                );
             });
         !cancel.load(Ordering::Relaxed)
     }
@@ -384,8 +404,13 @@ impl SppmIntegrator {
 impl Integrator for SppmIntegrator {
     fn render_pass(&mut self, scene: &Scene, camera: &Camera, cancel: &AtomicBool) -> bool {
         let start = Instant::now();
+        // RGB or spectral, chosen once per pass: each is its own compiled loop.
+        let spectral = self.settings.spectral || scene.has_dispersion();
         let mut visible = std::mem::take(&mut self.samples);
-        self.camera_pass(scene, camera, cancel, &mut visible);
+        match spectral {
+            true => self.camera_pass::<SampledSpectrum>(scene, camera, cancel, &mut visible),
+            false => self.camera_pass::<Color>(scene, camera, cancel, &mut visible),
+        }
         if cancel.load(Ordering::Relaxed) {
             self.samples = visible;
             return false;
@@ -411,7 +436,10 @@ impl Integrator for SppmIntegrator {
         });
         let photons_start = Instant::now();
         let sources = PhotonSources::new(scene);
-        let completed = self.photon_pass(scene, &sources, &visible, cancel);
+        let completed = match spectral {
+            true => self.photon_pass::<SampledSpectrum>(scene, &sources, &visible, cancel),
+            false => self.photon_pass::<Color>(scene, &sources, &visible, cancel),
+        };
         if !completed {
             self.clear_tallies();
             self.samples = visible;

@@ -14,6 +14,11 @@
 //!   photon travelling along −ω (pbrt-v4 §12.5, `UniformInfiniteLight::SampleLe`).
 //!   Every photon crossing the bounding sphere is reachable this way, and it
 //!   carries Φ = L / (p_select · p_ω · p_disc) = 4π · πR² · L / p_select.
+//!
+//! A photon carries RGB flux, or in spectral mode the flux at its own
+//! sampled wavelengths (drawn from a side stream of its sampler, so its
+//! other draws are those of an RGB photon); a dispersive interface sends it
+//! on at its hero wavelength only, as for camera paths.
 
 use crate::color::{Color, luminance};
 use crate::geometry::SurfaceHit;
@@ -22,16 +27,19 @@ use crate::material::{ShadingPoint, Transport};
 use crate::math::{DVec3, Frame as ShadingFrame, Ray, warp};
 use crate::sampler::Sampler;
 use crate::scene::Scene;
+use crate::spectrum::Radiance;
 use std::f64::consts::PI;
 
-/// A photon leaving a light.
+/// A photon leaving a light, carrying RGB or spectral flux `C`.
 #[derive(Clone, Copy, Debug)]
-pub struct Photon {
+pub struct Photon<C: Radiance = Color> {
     /// Where it starts (offset off the light's surface, or on a disc outside
     /// the scene for sky photons) and which way it travels.
     pub ray: Ray,
     /// Flux carried, in watts per emitted photon (before dividing by the count).
-    pub flux: Color,
+    pub flux: C,
+    /// Its wavelengths (nothing in RGB).
+    pub wavelengths: C::Wavelengths,
 }
 
 /// A constant, non-black background as a photon source.
@@ -88,24 +96,31 @@ impl PhotonSources {
     /// Draws one photon; `None` if nothing emits or the sample is degenerate.
     /// Without a sky, the samples drawn are exactly those of a scene whose
     /// only sources are its shapes.
-    pub fn emit(&self, scene: &Scene, sampler: &mut Sampler) -> Option<Photon> {
+    pub fn emit<C: Radiance>(&self, scene: &Scene, sampler: &mut Sampler) -> Option<Photon<C>> {
+        let wavelengths = C::sample_wavelengths(sampler);
         let u_select = sampler.next_1d();
         let Some(sky) = self.sky else {
-            return emit_from_shape(scene, u_select, 1.0, sampler);
+            return emit_from_shape(scene, u_select, 1.0, sampler, wavelengths);
         };
         let p_sky = self.sky_probability;
         if u_select < p_sky {
-            return emit_from_sky(&sky, p_sky, sampler);
+            return emit_from_sky(&sky, p_sky, sampler, wavelengths);
         }
         // Reuse the selection sample: it is uniform on [p_sky, 1) here.
         let u_shape = ((u_select - p_sky) / (1.0 - p_sky)).min(1.0 - f64::EPSILON / 2.0);
-        emit_from_shape(scene, u_shape, 1.0 - p_sky, sampler)
+        emit_from_shape(scene, u_shape, 1.0 - p_sky, sampler, wavelengths)
     }
 }
 
 /// A photon from the emissive shapes, chosen by `u_select`, which is itself
 /// chosen with probability `shape_probability`.
-fn emit_from_shape(scene: &Scene, u_select: f64, shape_probability: f64, sampler: &mut Sampler) -> Option<Photon> {
+fn emit_from_shape<C: Radiance>(
+    scene: &Scene,
+    u_select: f64,
+    shape_probability: f64,
+    sampler: &mut Sampler,
+    wavelengths: C::Wavelengths,
+) -> Option<Photon<C>> {
     let (index, light_probability) = scene.lights.choose(u_select)?;
     let select_probability = light_probability * shape_probability;
     let light = &scene.lights.lights[index as usize];
@@ -124,15 +139,21 @@ fn emit_from_shape(scene: &Scene, u_select: f64, shape_probability: f64, sampler
         return None;
     }
     let direction = ShadingFrame::from_normal(normal).to_world(local);
-    let flux = light.radiance * (local.z / (select_probability * area_pdf * direction_pdf));
+    let flux = C::from_rgb(light.radiance, &wavelengths) * (local.z / (select_probability * area_pdf * direction_pdf));
     Some(Photon {
         ray: Ray::spawn(on_light.point, on_light.point_error, normal, direction),
         flux,
+        wavelengths,
     })
 }
 
 /// A photon from the sky, which was chosen with probability `select_probability`.
-fn emit_from_sky(sky: &Sky, select_probability: f64, sampler: &mut Sampler) -> Option<Photon> {
+fn emit_from_sky<C: Radiance>(
+    sky: &Sky,
+    select_probability: f64,
+    sampler: &mut Sampler,
+    wavelengths: C::Wavelengths,
+) -> Option<Photon<C>> {
     let towards_sky = warp::square_to_uniform_sphere(sampler.next_2d());
     let disc = sky.radius * warp::square_to_concentric_disk(sampler.next_2d());
     let frame = ShadingFrame::from_normal(towards_sky);
@@ -141,26 +162,31 @@ fn emit_from_sky(sky: &Sky, select_probability: f64, sampler: &mut Sampler) -> O
     if select_probability <= 0.0 || !disc_pdf.is_finite() {
         return None;
     }
-    let flux = sky.radiance / (select_probability * warp::UNIFORM_SPHERE_PDF * disc_pdf);
+    let flux = C::from_rgb(sky.radiance, &wavelengths) / (select_probability * warp::UNIFORM_SPHERE_PDF * disc_pdf);
     Some(Photon {
         ray: Ray::new(origin, -towards_sky),
         flux,
+        wavelengths,
     })
 }
 
 /// Follows `photon` for up to `max_depth` surface hits, calling
-/// `deposit(hit, towards_light, flux)` at each non-specular one, where
-/// `towards_light` is the unit direction the photon arrived from.
+/// `deposit(hit, towards_light, flux, wavelengths)` at each non-specular
+/// one, where `towards_light` is the unit direction the photon arrived from.
 /// Scattering samples the BSDF for importance transport and Russian roulette
 /// keeps the flux per photon roughly constant (pbrt-v3 §16.2.3).
-pub fn trace(
+pub fn trace<C: Radiance>(
     scene: &Scene,
-    photon: Photon,
+    photon: Photon<C>,
     sampler: &mut Sampler,
     max_depth: u32,
-    mut deposit: impl FnMut(&SurfaceHit, DVec3, Color),
+    mut deposit: impl FnMut(&SurfaceHit, DVec3, C, &C::Wavelengths),
 ) {
-    let Photon { mut ray, mut flux } = photon;
+    let Photon {
+        mut ray,
+        mut flux,
+        mut wavelengths,
+    } = photon;
     for depth in 1..=max_depth {
         let Some(intersection) = scene.intersect(&ray, f64::INFINITY) else {
             return;
@@ -172,7 +198,7 @@ pub fn trace(
         }
         let towards_light = -ray.direction;
         if !material.is_specular() {
-            deposit(&hit, towards_light, flux);
+            deposit(&hit, towards_light, flux, &wavelengths);
         }
         if depth == max_depth {
             return;
@@ -186,15 +212,17 @@ pub fn trace(
         };
         let u = sampler.next_2d();
         let u_lobe = sampler.next_1d();
-        let Some(sample) = material.sample(frame.to_local(towards_light), &at, u, u_lobe, Transport::Importance) else {
+        let wo = frame.to_local(towards_light);
+        let Some(sample) = C::sample_bsdf(material, wo, &at, u, u_lobe, Transport::Importance, &mut wavelengths) else {
             return;
         };
         let direction = frame.to_world(sample.wi);
-        let scattered = flux * sample.weight * shading_normal_correction(&hit, towards_light, direction);
+        let scattered =
+            flux * C::from_rgb(sample.weight, &wavelengths) * shading_normal_correction(&hit, towards_light, direction);
 
         // Russian roulette: continue with probability of the luminance ratio,
         // so surviving photons keep about the flux they had.
-        let continue_probability = (luminance(scattered) / luminance(flux)).min(1.0);
+        let continue_probability = (scattered.brightness() / flux.brightness()).min(1.0);
         if continue_probability.is_nan() || continue_probability <= 0.0 || sampler.next_1d() >= continue_probability {
             return;
         }
@@ -224,7 +252,7 @@ mod tests {
     use std::path::Path;
 
     fn emit(scene: &Scene, sampler: &mut Sampler) -> Option<Photon> {
-        PhotonSources::new(scene).emit(scene, sampler)
+        PhotonSources::new(scene).emit::<Color>(scene, sampler)
     }
 
     fn scene(text: &str) -> Scene {

@@ -8,7 +8,7 @@
 
 use crate::color::Color;
 use std::f64::consts::PI;
-use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicI64, AtomicU32, Ordering};
 
 /// What one pixel has gathered over all iterations.
 #[derive(Clone, Copy, Debug, Default)]
@@ -58,14 +58,16 @@ impl PixelStatistics {
 
 /// One pass's photons at one visible point: flux Φ and count M, added
 /// concurrently by photon-tracing threads without locks. Flux is summed in
-/// 32.32 fixed point relative to a scene-wide unit (the mean photon flux), in
-/// atomic integers: integer addition is associative, so the total does not
-/// depend on which thread adds first, and the image stays a pure function of
-/// the seed. The rounding error per photon is 2⁻³² units (about 1e-10 of a
+/// signed 32.32 fixed point relative to a scene-wide unit (the mean photon
+/// flux), in atomic integers: two's-complement addition is associative, so
+/// the total does not depend on which thread adds first, and the image stays
+/// a pure function of the seed. Signed, because a spectral photon's film RGB
+/// can have a negative channel (a saturated wavelength lies outside the sRGB
+/// gamut); its mean over wavelengths is the right, non-negative value. The rounding error per photon is 2⁻³² units (about 1e-10 of a
 /// typical contribution); a pixel would need ~4·10⁹ units in one pass to overflow.
 #[derive(Debug, Default)]
 pub struct PhotonTally {
-    flux: [AtomicU64; 3],
+    flux: [AtomicI64; 3],
     count: AtomicU32,
 }
 
@@ -79,8 +81,8 @@ impl PhotonTally {
     #[inline]
     pub fn add(&self, flux: Color, inverse_unit: f64) {
         for (channel, value) in self.flux.iter().zip(flux.to_array()) {
-            let units = (value * inverse_unit).clamp(0.0, MAX_UNITS_PER_PHOTON);
-            let fixed = (units * FIXED_POINT_ONE).round() as u64;
+            let units = (value * inverse_unit).clamp(-MAX_UNITS_PER_PHOTON, MAX_UNITS_PER_PHOTON);
+            let fixed = (units * FIXED_POINT_ONE).round() as i64;
             if fixed != 0 {
                 channel.fetch_add(fixed, Ordering::Relaxed);
             }

@@ -6,12 +6,21 @@
 //! Emission met along the specular chain is returned separately; light that
 //! reaches the visible point after any diffuse or glossy reflection is left
 //! entirely to the photons (the classic, consistent split).
+//!
+//! In spectral mode the path carries its own wavelengths and its emitted
+//! term is a spectral estimate. The visible point's weight, which multiplies
+//! photon flux gathered at other wavelengths, is kept in RGB: the product of
+//! the chain's RGB weights, exact for clear glass and white mirrors; or,
+//! once a dispersive interface has narrowed the path to its hero wavelength,
+//! the film RGB of the hero's throughput (pbrt-v4's SPPM likewise multiplies
+//! the two sides in sensor RGB).
 
 use crate::color::Color;
 use crate::material::{ShadingPoint, Transport};
 use crate::math::{DVec3, Frame as ShadingFrame, Ray};
 use crate::sampler::Sampler;
 use crate::scene::Scene;
+use crate::spectrum::Radiance;
 
 /// Where one pixel's camera path met its first non-specular surface.
 #[derive(Clone, Copy, Debug)]
@@ -54,14 +63,18 @@ pub struct CameraPath {
     pub visible_point: Option<VisiblePoint>,
 }
 
-/// Traces `ray` through up to `max_depth` specular bounces.
-pub fn trace_camera_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, max_depth: u32) -> CameraPath {
-    let mut result = CameraPath::default();
-    let mut throughput = Color::ONE;
+/// Traces `ray` through up to `max_depth` specular bounces, carrying RGB
+/// or the wavelengths `C` draws from `sampler`'s side stream.
+pub fn trace_camera_path<C: Radiance>(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, max_depth: u32) -> CameraPath {
+    let mut wavelengths = C::sample_wavelengths(sampler);
+    let mut visible_point = None;
+    let mut emitted = C::ZERO;
+    let mut throughput = C::ONE;
+    let mut rgb_throughput = Color::ONE;
     let mut path_length = 0.0;
     for _ in 0..=max_depth {
         let Some(intersection) = scene.intersect(&ray, f64::INFINITY) else {
-            result.emitted += throughput * scene.background;
+            emitted += throughput * C::from_rgb(scene.background, &wavelengths);
             break;
         };
         let hit = intersection.hit;
@@ -70,7 +83,7 @@ pub fn trace_camera_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, max
         let material = &scene.materials[material_index as usize];
         let wo_world = -ray.direction;
         // Every vertex here ends a purely specular chain, so emission counts in full.
-        result.emitted += throughput * material.emitted(hit.geometric_normal.dot(wo_world));
+        emitted += throughput * C::from_rgb(material.emitted(hit.geometric_normal.dot(wo_world)), &wavelengths);
         if !material.scatters() {
             break;
         }
@@ -81,7 +94,11 @@ pub fn trace_camera_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, max
             point: hit.point,
         };
         if !material.is_specular() {
-            result.visible_point = Some(VisiblePoint {
+            let throughput = match C::is_dispersed(&wavelengths) {
+                true => throughput.to_rgb(&wavelengths),
+                false => rgb_throughput,
+            };
+            visible_point = Some(VisiblePoint {
                 point: hit.point,
                 geometric_normal: hit.geometric_normal,
                 frame,
@@ -96,14 +113,18 @@ pub fn trace_camera_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, max
         // Mirror or glass: follow the one sampled direction.
         let u = sampler.next_2d();
         let u_lobe = sampler.next_1d();
-        let Some(sample) = material.sample(wo, &at, u, u_lobe, Transport::Radiance) else {
+        let Some(sample) = C::sample_bsdf(material, wo, &at, u, u_lobe, Transport::Radiance, &mut wavelengths) else {
             break;
         };
-        throughput *= sample.weight;
-        if throughput == Color::ZERO {
+        throughput *= C::from_rgb(sample.weight, &wavelengths);
+        rgb_throughput *= sample.weight;
+        if throughput == C::ZERO {
             break;
         }
         ray = Ray::spawn(hit.point, hit.point_error, hit.geometric_normal, frame.to_world(sample.wi));
     }
-    result
+    CameraPath {
+        emitted: emitted.to_rgb(&wavelengths),
+        visible_point,
+    }
 }
