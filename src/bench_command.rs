@@ -6,6 +6,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use prism::bench::{self, error_curves, plot, rays, scaling, sppm_schedules, stress, throughput};
 use prism::output::load_frame;
+use prism::render::{IntegratorKind, RenderSettings};
 use prism::scene::{self, LoadedScene};
 use std::path::{Path, PathBuf};
 
@@ -43,6 +44,10 @@ pub struct BenchArgs {
     /// Width of rendered references, in pixels (height follows the scene's aspect).
     #[arg(long, default_value_t = 256)]
     reference_width: u32,
+    /// Integrator of rendered references: pt (unbiased, the default) or, for
+    /// caustics seen only through specular paths from a tiny light, sppm.
+    #[arg(long, default_value = "pt", value_parser = crate::parse_integrator)]
+    reference_integrator: IntegratorKind,
     /// Measure BVH build, ray cost and render time scaling instead.
     #[arg(long)]
     scaling: bool,
@@ -140,7 +145,10 @@ fn references_command(args: &BenchArgs, seconds: f64) -> Result<()> {
     }
     for file in scene_files(args)? {
         let loaded = scene::load_scene_file(&file)?;
-        let settings = error_curves::reference_settings(&loaded.settings, args.reference_width, seconds);
+        let settings = RenderSettings {
+            integrator: args.reference_integrator,
+            ..error_curves::reference_settings(&loaded.settings, args.reference_width, seconds)
+        };
         let path = error_curves::reference_path(&args.references, &file);
         eprintln!(
             "{}: rendering {}x{} for {seconds} s ...",
@@ -150,8 +158,14 @@ fn references_command(args: &BenchArgs, seconds: f64) -> Result<()> {
         );
         let passes = error_curves::make_reference(&loaded, &settings, &path)?;
         eprintln!(
-            "wrote {} ({passes} samples per pixel, seed {})",
+            "wrote {} ({passes} {} of {}, seed {})",
             path.display(),
+            if settings.integrator == IntegratorKind::Sppm {
+                "iterations"
+            } else {
+                "samples per pixel"
+            },
+            settings.integrator,
             settings.seed
         );
     }

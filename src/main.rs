@@ -134,7 +134,7 @@ fn parse_sampler(s: &str) -> Result<SamplerKind, String> {
     }
 }
 
-fn parse_integrator(s: &str) -> Result<IntegratorKind, String> {
+pub(crate) fn parse_integrator(s: &str) -> Result<IntegratorKind, String> {
     IntegratorKind::ALL
         .into_iter()
         .find(|k| k.name() == s)
