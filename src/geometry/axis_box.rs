@@ -115,7 +115,6 @@ impl AxisBox {
             point,
             point_error: gamma(3) * point.abs(),
             normal,
-            uv: self.face_uv(point, axis),
         }
     }
 }

@@ -28,8 +28,7 @@ pub struct AreaSample {
     /// Conservative absolute error bound of `point`, per axis (for
     /// [`crate::math::Ray::spawn`]).
     pub point_error: DVec3,
-    /// Unit outward normal at `point`.
+    /// Unit outward normal at `point`. (No texture coordinates: emission is
+    /// not textured, and a sphere's would cost an atan2 and an acos.)
     pub normal: DVec3,
-    /// Surface parameterisation at `point`, as [`SurfaceHit::uv`] reports it.
-    pub uv: DVec2,
 }

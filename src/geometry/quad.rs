@@ -104,7 +104,6 @@ impl Quad {
             point,
             point_error: gamma(6) * (self.corner.abs() + (u.x * self.edge_u).abs() + (u.y * self.edge_v).abs()),
             normal: self.normal,
-            uv: u,
         }
     }
 }

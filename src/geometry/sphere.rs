@@ -167,12 +167,15 @@ impl Sphere {
     /// Uniform point on the surface; density `1 / area`.
     pub fn sample_area(&self, u: DVec2) -> AreaSample {
         let normal = warp::square_to_uniform_sphere(u);
-        let hit = self.hit_at(self.center + self.radius * normal, 0.0);
+        // The point as `hit_at` places one (its normal renormalised from
+        // the approximate point), so samples are those of earlier versions
+        // bit for bit; without the hit record's uv (an atan2 and an acos).
+        let on_surface = (self.center + self.radius * normal - self.center).normalize();
+        let (point, point_error) = self.point_with_normal(on_surface);
         AreaSample {
-            point: hit.point,
-            point_error: hit.point_error,
+            point,
+            point_error,
             normal,
-            uv: hit.uv,
         }
     }
 }

@@ -193,7 +193,6 @@ impl Triangle {
             point,
             point_error: gamma(6) * ((b0 * a).abs() + (b.x * v1).abs() + (b.y * v2).abs()),
             normal: self.face_normal().normalize(),
-            uv: b,
         }
     }
 }

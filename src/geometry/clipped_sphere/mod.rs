@@ -155,8 +155,6 @@ impl ClippedSphere {
                     point,
                     point_error,
                     normal,
-                    // Not a texture lookup: emission is not textured.
-                    uv: DVec2::ZERO,
                 };
                 sampling::by_area(on_cap, area, reference)
             }

@@ -54,35 +54,27 @@ impl Revolution {
         };
         let phi = TAU * u.y.clamp(0.0, 1.0);
         let (sin_phi, cos_phi) = phi.sin_cos();
-        let (local_point, local_normal, uv, local_error) = if component < self.segments.len() {
+        let (local_point, local_normal, local_error) = if component < self.segments.len() {
             let segment = &self.segments[component];
             let t = segment.invert_area(target - before);
             let (point, _) = bezier::evaluate_with_derivative(&segment.points, t);
             let normal = profile_normal(&segment.points, t, point.x, cos_phi, sin_phi);
-            let v = (component as f64 + t) / self.segments.len() as f64;
             let local = DVec3::new(point.x * cos_phi, point.x * sin_phi, point.y);
             let error = gamma(4 * segment.degree as u32 + 16) * (self.size + point.x + point.y.abs());
-            (local, normal, DVec2::new(u.y, v), error)
+            (local, normal, error)
         } else {
             let cap = self.caps[component - self.segments.len()];
             let fraction = ((target - before) / cap.area()).clamp(0.0, 1.0);
             // Uniform on the disc: r = R √ξ has density 2r/R² (pbrt-v4 A.5.1).
             let r = cap.radius * fraction.sqrt();
             let local = DVec3::new(r * cos_phi, r * sin_phi, cap.z);
-            let v = if cap.side < 0.0 { 0.0 } else { 1.0 };
-            (
-                local,
-                DVec3::new(0.0, 0.0, cap.side),
-                DVec2::new(u.y, v),
-                gamma(8) * (self.size + r),
-            )
+            (local, DVec3::new(0.0, 0.0, cap.side), gamma(8) * (self.size + r))
         };
         let (point, point_error) = self.to_world_with_error(local_point, DVec3::splat(local_error));
         AreaSample {
             point,
             point_error,
             normal: (self.normal_to_world * local_normal).normalize(),
-            uv,
         }
     }
 }
