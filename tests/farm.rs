@@ -120,6 +120,27 @@ fn global_schedule_sppm_parts_merge_into_one_run() {
     assert!(whole.frame().channel_means().iter().all(|&m| m > 0.0), "SPPM saw no light");
 }
 
+/// The same for spectral SPPM (photons with their own wavelengths) on the
+/// dispersive scene.
+#[test]
+fn spectral_global_schedule_sppm_parts_merge_into_one_run() {
+    let mut loaded = shipped_scene("dispersion.toml");
+    assert!(loaded.scene.has_dispersion());
+    loaded.settings.sppm.photons_per_iteration = 4_000;
+    loaded.settings.sppm.radius_schedule = RadiusSchedule::Global;
+    let settings = RenderSettings {
+        width: 16,
+        height: 12,
+        samples_per_pixel: Some(7),
+        integrator: IntegratorKind::Sppm,
+        max_depth: 8,
+        seed: 5,
+        ..loaded.settings.clone()
+    };
+    let whole = check_parts_merge_exactly(&loaded, &settings, "spectral sppm/global");
+    assert!(whole.frame().channel_means().iter().all(|&m| m > 0.0), "SPPM saw no light");
+}
+
 /// Explicit ranges in any order and through film files give the same bits;
 /// so does a merge of merges (hierarchical), and a range starting past 0.
 #[test]
