@@ -31,11 +31,19 @@ const _: () = assert!(2 * bezier::MAX_DEGREE < MAX_COEFFICIENTS);
 
 /// Smallest and largest of the coefficients.
 pub(super) fn range(coefficients: &[f64]) -> (f64, f64) {
-    coefficients
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(low, high), &c| {
-            (low.min(c), high.max(c))
-        })
+    // Plain comparisons rather than f64::min/max, whose NaN rule costs
+    // extra instructions on this hot path; a NaN coefficient is skipped
+    // either way (every comparison with it is false).
+    let (mut low, mut high) = (f64::INFINITY, f64::NEG_INFINITY);
+    for &c in coefficients {
+        if c < low {
+            low = c;
+        }
+        if c > high {
+            high = c;
+        }
+    }
+    (low, high)
 }
 
 /// `F = a² − D_z² (x − δ)(x + δ)` on a sub-interval of `t`, as its factors'
