@@ -8,15 +8,20 @@
 
 use crate::color::{Color, luminance};
 use crate::geometry::{AreaSample, ClippedSphere, Shape, ShapeSample, Triangle};
+use crate::spectrum::{Emission, EmissionSpectrum};
 use glam::{DVec2, DVec3};
+use std::sync::Arc;
 
 /// One emissive primitive.
 #[derive(Clone, Debug)]
 pub struct Light {
     /// The primitive's id in the scene.
     pub primitive: u32,
-    /// Emitted radiance Le, constant over the surface and over directions.
+    /// Emitted radiance Le, constant over the surface and over directions,
+    /// as the film's RGB (for a spectral emitter, its spectrum's RGB).
     pub radiance: Color,
+    /// The light's own spectrum, if it has one (see `Material::Emissive`).
+    pub spectrum: Option<Arc<EmissionSpectrum>>,
     /// Whether it emits from both faces; otherwise only towards the side its
     /// geometric normal points to.
     pub two_sided: bool,
@@ -26,9 +31,21 @@ pub struct Light {
     pub clipped: Option<Box<ClippedSphere>>,
 }
 
+impl Light {
+    /// What the light emits, in the form [`Radiance::emission`] takes.
+    ///
+    /// [`Radiance::emission`]: crate::spectrum::Radiance::emission
+    pub fn emission(&self) -> Emission<'_> {
+        Emission {
+            rgb: self.radiance,
+            spectrum: self.spectrum.as_deref(),
+        }
+    }
+}
+
 /// A point chosen on a light, seen from a reference point.
 #[derive(Clone, Copy, Debug)]
-pub struct LightSample {
+pub struct LightSample<'a> {
     /// Unit direction from the reference point to the light point.
     pub wi: DVec3,
     /// Distance from the reference point to `point`.
@@ -41,7 +58,7 @@ pub struct LightSample {
     /// Unit outward normal of the light at `point`.
     pub normal: DVec3,
     /// Radiance the light emits towards the reference point.
-    pub radiance: Color,
+    pub emission: Emission<'a>,
     /// Solid-angle density, including the probability of choosing this light.
     pub pdf: f64,
 }
@@ -169,7 +186,7 @@ impl Lights {
     }
 
     /// Samples a point on a light as seen from `reference`.
-    pub fn sample(&self, source: &impl EmitterSource, reference: DVec3, u_select: f64, u: DVec2) -> Option<LightSample> {
+    pub fn sample(&self, source: &impl EmitterSource, reference: DVec3, u_select: f64, u: DVec2) -> Option<LightSample<'_>> {
         let (index, selection) = self.choose(u_select)?;
         let light = &self.lights[index as usize];
         let sample = match &light.clipped {
@@ -189,7 +206,7 @@ impl Lights {
             point: sample.point,
             point_error: sample.point_error,
             normal: sample.normal,
-            radiance: light.radiance,
+            emission: light.emission(),
             pdf: sample.pdf * selection,
         })
     }

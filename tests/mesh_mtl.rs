@@ -81,8 +81,13 @@ fn mtl_materials_map_onto_prism_materials() {
     let obj = write_obj(&dir);
     let loaded = scene_with_mesh(&obj, None).expect("loads");
     match material_of_face(&loaded, 0) {
-        Material::Emissive { radiance, two_sided } => {
+        Material::Emissive {
+            radiance,
+            two_sided,
+            spectrum,
+        } => {
             assert_eq!((*radiance, *two_sided), (DVec3::new(4.0, 3.0, 2.0), false));
+            assert!(spectrum.is_none(), "an .mtl light is RGB");
         }
         other => panic!("lamp: {other:?}"),
     }

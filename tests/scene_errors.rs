@@ -155,6 +155,83 @@ fn range_error() {
     check("ior.toml", text, 7, 7, "materials.white.ior", "must be positive");
 }
 
+/// An emissive material gives an RGB `radiance`, or a `spectrum` or
+/// `temperature` with a `luminance`; each wrong combination or value is
+/// placed at the key that is wrong.
+#[test]
+fn spectral_light_errors_name_the_key() {
+    let light = |keys: &str| {
+        GOOD.replace(
+            "type = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]",
+            &format!("type = \"emissive\"\n{keys}"),
+        )
+    };
+    check(
+        "cold.toml",
+        light("temperature = 100\nluminance = 1"),
+        7,
+        15,
+        "materials.white.temperature",
+        "must be between 500 and 1000000 kelvin (found 100)",
+    );
+    check(
+        "d50.toml",
+        light("spectrum = \"D50\"\nluminance = 1"),
+        7,
+        12,
+        "materials.white.spectrum",
+        "unknown illuminant \"D50\" (known: D65, A)",
+    );
+    check(
+        "dark.toml",
+        light("spectrum = \"A\"\nluminance = -1"),
+        8,
+        13,
+        "materials.white.luminance",
+        "must not be negative (found -1)",
+    );
+    check(
+        "both.toml",
+        light("spectrum = \"A\"\ntemperature = 2000\nluminance = 1"),
+        8,
+        15,
+        "materials.white.temperature",
+        "not both",
+    );
+    check(
+        "scaled-rgb.toml",
+        light("radiance = [1, 1, 1]\nluminance = 2"),
+        8,
+        13,
+        "materials.white.luminance",
+        "an RGB `radiance` is its own scale",
+    );
+    check(
+        "rgb-and-spectrum.toml",
+        light("radiance = [1, 1, 1]\nspectrum = \"D65\"\nluminance = 2"),
+        7,
+        12,
+        "materials.white.radiance",
+        "not both",
+    );
+    check(
+        "unscaled.toml",
+        light("temperature = 2700"),
+        5,
+        1,
+        "materials.white.luminance",
+        "missing field `luminance`",
+    );
+    check(
+        "nothing.toml",
+        light("two_sided = true"),
+        5,
+        1,
+        "materials.white.radiance",
+        "missing field `radiance`",
+    );
+}
+
 #[test]
 fn reference_error() {
     let text = sphere_scene("material = \"white\"", "material = \"chrome\"");

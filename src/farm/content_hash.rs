@@ -113,14 +113,22 @@ fn hash_material(hash: &mut Fnv1a, material: &Material) {
                 }
             }
         }
-        // A glass without dispersion hashes as it did before glasses could
-        // disperse, so films rendered earlier still merge.
+        // A glass without dispersion, and an RGB light, hash as they did
+        // before glasses could disperse and lights have spectra, so films
+        // rendered earlier still merge.
         _ => match material {
             Material::Glass {
                 ior,
                 tint,
                 dispersion: None,
             } => hash.debug(&format_args!("Glass {{ ior: {ior:?}, tint: {tint:?} }}")),
+            Material::Emissive {
+                radiance,
+                two_sided,
+                spectrum: None,
+            } => hash.debug(&format_args!(
+                "Emissive {{ radiance: {radiance:?}, two_sided: {two_sided:?} }}"
+            )),
             _ => hash.debug(material),
         },
     }
@@ -129,6 +137,7 @@ fn hash_material(hash: &mut Fnv1a, material: &Material) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::color::Color;
     use crate::scene::{DEFAULT_SCENE, load_scene_str};
     use std::path::Path;
 
@@ -179,5 +188,48 @@ mod tests {
         assert!(hashes[0] != hashes[1] && hashes[1] != hashes[2]);
         // The [render] table is not the scene: settings are compared apart.
         assert_eq!(hashes[3], original);
+    }
+
+    /// An RGB light hashes as the material did before lights could have a
+    /// spectrum (a derived `Debug` of the old variant), so films rendered
+    /// then still merge; a spectral light hashes by its spectrum.
+    #[test]
+    fn rgb_lights_hash_as_before_and_spectra_count() {
+        // Read only through `Debug`, which is the point.
+        #[allow(dead_code)]
+        #[derive(Debug)]
+        enum Before {
+            Emissive { radiance: Color, two_sided: bool },
+        }
+        let hash_of = |material: &Material| {
+            let mut hash = Fnv1a(Fnv1a::OFFSET_BASIS);
+            hash_material(&mut hash, material);
+            hash.0
+        };
+        let radiance = Color::new(17.0, 12.0, 4.0);
+        let mut before = Fnv1a(Fnv1a::OFFSET_BASIS);
+        before.debug(&Before::Emissive {
+            radiance,
+            two_sided: true,
+        });
+        let rgb = Material::Emissive {
+            radiance,
+            two_sided: true,
+            spectrum: None,
+        };
+        assert_eq!(hash_of(&rgb), before.0);
+        let spectral = |source, luminance| {
+            let spectrum = crate::spectrum::EmissionSpectrum::new(source, luminance);
+            hash_of(&Material::Emissive {
+                radiance: spectrum.rgb(),
+                two_sided: true,
+                spectrum: Some(std::sync::Arc::new(spectrum)),
+            })
+        };
+        use crate::spectrum::{SpectrumSource, StandardIlluminant};
+        let d65 = spectral(SpectrumSource::Illuminant(StandardIlluminant::D65), 5.0);
+        assert_ne!(d65, spectral(SpectrumSource::Illuminant(StandardIlluminant::A), 5.0));
+        assert_ne!(d65, spectral(SpectrumSource::Illuminant(StandardIlluminant::D65), 6.0));
+        assert_ne!(d65, hash_of(&rgb));
     }
 }

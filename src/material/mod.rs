@@ -16,7 +16,9 @@ pub use texture::Texture;
 
 use crate::color::Color;
 use crate::spectrum::dispersion::Dispersion;
+use crate::spectrum::{Emission, EmissionSpectrum};
 use glam::{DVec2, DVec3};
+use std::sync::Arc;
 
 /// Which quantity a path carries: radiance from the camera, or importance
 /// (photons) from the lights. Refraction scales them differently (Veach 1997, §5.2).
@@ -89,10 +91,15 @@ pub enum Material {
     /// A light: emits `radiance` from its front (outward normal) side, or both
     /// sides when `two_sided`; reflects nothing.
     Emissive {
-        /// Emitted radiance Le, per channel.
+        /// Emitted radiance Le as the film's linear RGB; for a spectral
+        /// emitter, its spectrum's RGB (what RGB renders and light
+        /// selection use).
         radiance: Color,
         /// Emit from both faces, not just the front.
         two_sided: bool,
+        /// The emitter's own spectrum (a named illuminant or a blackbody);
+        /// `None`: `radiance`'s uplift, as for every RGB colour.
+        spectrum: Option<Arc<EmissionSpectrum>>,
     },
 }
 
@@ -123,12 +130,32 @@ impl Material {
     /// geometric normal.
     pub fn emitted(&self, cos_theta: f64) -> Color {
         match self {
-            Material::Emissive { radiance, two_sided } if *two_sided || cos_theta > 0.0 => *radiance,
+            Material::Emissive { radiance, two_sided, .. } if *two_sided || cos_theta > 0.0 => *radiance,
             _ => Color::ZERO,
         }
     }
 
-    /// The emitted radiance if this is a light, whatever the direction.
+    /// What this light emits towards a direction making `cos_theta` with
+    /// the geometric normal, in the form [`Radiance::emission`] takes;
+    /// `None` if it emits nothing that way (or is no light).
+    ///
+    /// [`Radiance::emission`]: crate::spectrum::Radiance::emission
+    #[inline]
+    pub fn emission_towards(&self, cos_theta: f64) -> Option<Emission<'_>> {
+        match self {
+            Material::Emissive {
+                radiance,
+                two_sided,
+                spectrum,
+            } if (*two_sided || cos_theta > 0.0) && *radiance != Color::ZERO => Some(Emission {
+                rgb: *radiance,
+                spectrum: spectrum.as_deref(),
+            }),
+            _ => None,
+        }
+    }
+
+    /// The emitted radiance (film RGB) if this is a light, whatever the direction.
     pub fn emission(&self) -> Option<Color> {
         match self {
             Material::Emissive { radiance, .. } => Some(*radiance),

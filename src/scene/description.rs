@@ -112,10 +112,22 @@ pub enum MaterialDescription {
         /// GGX α in [0, 1].
         roughness: f64,
     },
-    /// A light.
+    /// A light: an RGB `radiance`, or a spectrum (`spectrum` or
+    /// `temperature`) scaled by `luminance`.
     Emissive {
         /// Emitted radiance, linear RGB.
-        radiance: Vector,
+        #[serde(default)]
+        radiance: Option<Vector>,
+        /// A named CIE standard illuminant: `D65` or `A`.
+        #[serde(default)]
+        spectrum: Option<String>,
+        /// A blackbody's temperature, kelvin.
+        #[serde(default)]
+        temperature: Option<f64>,
+        /// CIE Y of a `spectrum` or `temperature` emitter, relative to the
+        /// film's white (that of `radiance = [1, 1, 1]`).
+        #[serde(default)]
+        luminance: Option<f64>,
         /// Emit from both faces; default false (front face only).
         #[serde(default)]
         two_sided: bool,

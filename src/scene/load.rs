@@ -19,11 +19,13 @@ use crate::math::Aabb;
 use crate::settings::validate::available_memory;
 use crate::settings::{RenderSettings, Setting, SettingError};
 use crate::spectrum::dispersion::Dispersion;
+use emission::EmissiveKeys;
 use glam::{DAffine3, DVec2, DVec3};
 use std::cell::RefCell;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
+mod emission;
 mod mesh;
 mod texture;
 
@@ -374,10 +376,22 @@ impl Builder<'_> {
                     roughness: *roughness,
                 }
             }
-            MaterialDescription::Emissive { radiance, two_sided } => Material::Emissive {
-                radiance: self.color(&path.key("radiance"), *radiance)?,
-                two_sided: *two_sided,
-            },
+            MaterialDescription::Emissive {
+                radiance,
+                spectrum,
+                temperature,
+                luminance,
+                two_sided,
+            } => self.emissive(
+                path,
+                EmissiveKeys {
+                    radiance: *radiance,
+                    spectrum: spectrum.as_deref(),
+                    temperature: *temperature,
+                    luminance: *luminance,
+                },
+                *two_sided,
+            )?,
         })
     }
 

@@ -132,9 +132,14 @@ impl Scene {
         };
         let lights: Vec<Light> = (0..scene.primitive_count() as u32)
             .filter_map(|primitive| match scene.material_of(primitive) {
-                Material::Emissive { radiance, two_sided } if *radiance != Color::ZERO => Some(Light {
+                Material::Emissive {
+                    radiance,
+                    two_sided,
+                    spectrum,
+                } if *radiance != Color::ZERO => Some(Light {
                     primitive,
                     radiance: *radiance,
+                    spectrum: spectrum.clone(),
                     two_sided: *two_sided,
                     clipped: None,
                 }),

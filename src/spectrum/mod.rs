@@ -6,18 +6,26 @@
 //! - [`sensor`]: the film's spectrum → XYZ → linear sRGB conversion;
 //! - [`dispersion`]: indices of refraction that vary with wavelength;
 //! - [`uplift`]: RGB reflectances and emissions as smooth spectra (Smits 1999);
+//! - [`illuminant`], [`blackbody`]: emission spectra of their own (CIE D65
+//!   and A, Planck's law), and [`emission`]: what a light emits, as RGB or
+//!   at sampled wavelengths;
 //! - [`radiance`]: the colour type a path tracer is generic over (RGB or a
 //!   [`SampledSpectrum`]).
 //!
 //! Wavelengths are in nanometres throughout.
 
+pub mod blackbody;
 pub mod cie;
 pub mod dispersion;
+pub mod emission;
+pub mod illuminant;
 pub mod radiance;
 pub mod sensor;
 pub mod uplift;
 pub mod wavelengths;
 
+pub use emission::{Emission, EmissionSpectrum, SpectrumSource};
+pub use illuminant::StandardIlluminant;
 pub use radiance::Radiance;
 pub use sensor::Sensor;
 pub use wavelengths::SampledWavelengths;

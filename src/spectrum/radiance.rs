@@ -5,6 +5,7 @@
 //! was (its uplift is the identity and it carries no wavelengths).
 
 use super::cie::CIE_1931_2DEG;
+use super::emission::Emission;
 use super::sensor::Sensor;
 use super::uplift::spectrum_of_rgb;
 use super::{SampledSpectrum, SampledWavelengths, WAVELENGTHS};
@@ -47,6 +48,11 @@ pub trait Radiance:
     /// dispersive interface), so its throughput is valid at that λ only.
     fn is_dispersed(wavelengths: &Self::Wavelengths) -> bool;
 
+    /// Emitted radiance in this form: the film RGB, or the emitter's own
+    /// spectrum (an RGB emitter's uplift) at the wavelengths. Every place
+    /// emission enters a path takes it through here.
+    fn emission(emission: Emission<'_>, wavelengths: &Self::Wavelengths) -> Self;
+
     /// The largest component (for Russian roulette).
     fn max_component(self) -> f64;
 
@@ -86,6 +92,11 @@ impl Radiance for Color {
     #[inline(always)]
     fn is_dispersed(_: &()) -> bool {
         false
+    }
+
+    #[inline(always)]
+    fn emission(emission: Emission<'_>, _: &()) -> Self {
+        emission.rgb
     }
 
     #[inline(always)]
@@ -133,6 +144,11 @@ impl Radiance for SampledSpectrum {
 
     fn is_dispersed(wavelengths: &SampledWavelengths) -> bool {
         wavelengths.secondary_terminated()
+    }
+
+    #[inline]
+    fn emission(emission: Emission<'_>, wavelengths: &SampledWavelengths) -> Self {
+        emission.sample(wavelengths)
     }
 
     #[inline]

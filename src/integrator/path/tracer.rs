@@ -59,7 +59,8 @@ impl PathTracer {
     }
 
     /// The path tracer proper, over either colour type (see [`Radiance`]):
-    /// RGB values from materials and lights enter through `C::from_rgb`.
+    /// RGB values from materials enter through `C::from_rgb`, emission through
+    /// `C::emission` (an emitter may have a spectrum of its own).
     fn trace<C: Radiance>(&self, scene: &Scene, mut ray: Ray, sampler: &mut Sampler, wavelengths: &mut C::Wavelengths) -> C {
         let mut radiance = C::ZERO;
         let mut throughput = C::ONE;
@@ -78,20 +79,17 @@ impl PathTracer {
             let wo_world = -ray.direction;
 
             // Emission found by the BSDF sample, weighted against light sampling.
-            if material.emission().is_some() {
-                let emitted = material.emitted(hit.geometric_normal.dot(wo_world));
-                if emitted != Color::ZERO {
-                    let weight = match scene.lights.light_of_primitive(intersection.primitive) {
-                        Some(light) if light_sampling && !specular_bounce => {
-                            let light_pdf = scene
-                                .lights
-                                .pdf(scene, light, previous_point, hit.point, hit.geometric_normal);
-                            power_heuristic(previous_pdf, light_pdf)
-                        }
-                        _ => 1.0,
-                    };
-                    radiance += throughput * C::from_rgb(emitted, wavelengths) * weight;
-                }
+            if let Some(emitted) = material.emission_towards(hit.geometric_normal.dot(wo_world)) {
+                let weight = match scene.lights.light_of_primitive(intersection.primitive) {
+                    Some(light) if light_sampling && !specular_bounce => {
+                        let light_pdf = scene
+                            .lights
+                            .pdf(scene, light, previous_point, hit.point, hit.geometric_normal);
+                        power_heuristic(previous_pdf, light_pdf)
+                    }
+                    _ => 1.0,
+                };
+                radiance += throughput * C::emission(emitted, wavelengths) * weight;
             }
             if !material.scatters() || bounce >= self.max_depth {
                 break;
@@ -120,7 +118,7 @@ impl PathTracer {
                         if !scene.occluded(&shadow, t_max) {
                             let weight = power_heuristic(light.pdf, material.pdf(wo, wi));
                             let f = C::from_rgb(f, wavelengths);
-                            radiance += throughput * f * C::from_rgb(light.radiance, wavelengths) * (weight / light.pdf);
+                            radiance += throughput * f * C::emission(light.emission, wavelengths) * (weight / light.pdf);
                         }
                     }
                 }

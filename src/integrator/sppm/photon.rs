@@ -139,7 +139,7 @@ fn emit_from_shape<C: Radiance>(
         return None;
     }
     let direction = ShadingFrame::from_normal(normal).to_world(local);
-    let flux = C::from_rgb(light.radiance, &wavelengths) * (local.z / (select_probability * area_pdf * direction_pdf));
+    let flux = C::emission(light.emission(), &wavelengths) * (local.z / (select_probability * area_pdf * direction_pdf));
     Some(Photon {
         ray: Ray::spawn(on_light.point, on_light.point_error, normal, direction),
         flux,

@@ -20,7 +20,7 @@ use crate::material::{ShadingPoint, Transport};
 use crate::math::{DVec3, Frame as ShadingFrame, Ray};
 use crate::sampler::Sampler;
 use crate::scene::Scene;
-use crate::spectrum::Radiance;
+use crate::spectrum::{Emission, Radiance};
 
 /// Where one pixel's camera path met its first non-specular surface.
 #[derive(Clone, Copy, Debug)]
@@ -83,7 +83,10 @@ pub fn trace_camera_path<C: Radiance>(scene: &Scene, mut ray: Ray, sampler: &mut
         let material = &scene.materials[material_index as usize];
         let wo_world = -ray.direction;
         // Every vertex here ends a purely specular chain, so emission counts in full.
-        emitted += throughput * C::from_rgb(material.emitted(hit.geometric_normal.dot(wo_world)), &wavelengths);
+        let emission = material
+            .emission_towards(hit.geometric_normal.dot(wo_world))
+            .unwrap_or(Emission::NONE);
+        emitted += throughput * C::emission(emission, &wavelengths);
         if !material.scatters() {
             break;
         }

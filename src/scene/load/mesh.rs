@@ -194,6 +194,7 @@ impl Builder<'_> {
             Material::Emissive {
                 radiance: emission.unwrap_or_default(),
                 two_sided: false,
+                spectrum: None,
             }
         } else if transparent {
             used.extend(["d", "Ni", "Tf"]);
