@@ -137,8 +137,8 @@ impl Bvh {
     }
 
     /// As [`Bvh::build`], with leaves of kind k holding at most
-    /// `max_leaf_size[k]` primitives (1 to 4): 1 suits primitives whose
-    /// test costs far more than a box test.
+    /// `max_leaf_size[k]` primitives (1, 2 or 4; 3 is taken as 2): 1 suits
+    /// primitives whose test costs far more than a box test.
     pub fn build_with_leaf_sizes(
         primitives: &[BuildPrimitive],
         max_leaf_size: [usize; KIND_COUNT],
