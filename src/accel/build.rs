@@ -370,10 +370,10 @@ impl Bins {
         let total = i32x4::splat(count as i32);
         let (mut left, mut left_count) = ([Box4::EMPTY; 3], i32x4::ZERO);
         let (mut best_cost, mut best_plane) = (f32x4::splat(f32::INFINITY), i32x4::ZERO);
-        for plane in 1..BIN_COUNT {
+        for (plane, &right_of_plane) in right_cost.iter().enumerate().skip(1) {
             left = std::array::from_fn(|axis| left[axis].union(&self.bounds[plane - 1][axis]));
             left_count += i32x4::new(self.counts[plane - 1]);
-            let cost = half_areas(&left) * blocks(left_count, block_shift) + right_cost[plane];
+            let cost = half_areas(&left) * blocks(left_count, block_shift) + right_of_plane;
             let splits = left_count.cmp_gt(i32x4::ZERO) & left_count.cmp_lt(total);
             let better: i32x4 = splits & bytemuck::cast::<f32x4, i32x4>(cost.cmp_lt(best_cost));
             best_cost = bytemuck::cast::<i32x4, f32x4>(better).blend(cost, best_cost);
@@ -381,9 +381,9 @@ impl Bins {
         }
         let (costs, planes) = (best_cost.to_array(), best_plane.to_array());
         let mut best: Option<(usize, usize)> = None;
-        for axis in 0..3 {
-            if costs[axis] < best.map_or(f32::INFINITY, |(axis, _)| costs[axis]) {
-                best = Some((axis, planes[axis] as usize));
+        for (axis, (&cost, &plane)) in costs.iter().zip(&planes).take(3).enumerate() {
+            if cost < best.map_or(f32::INFINITY, |(best_axis, _)| costs[best_axis]) {
+                best = Some((axis, plane as usize));
             }
         }
         best

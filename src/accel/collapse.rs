@@ -75,11 +75,11 @@ impl<'a> Collapse<'a> {
                 left_slots: [0; WIDTH],
                 left_slots_below: opened[WIDTH].1,
             };
-            for k in 2..=WIDTH {
+            for (k, &(cost, left_slots)) in opened.iter().enumerate().skip(2) {
                 // On a tie, open: one wide node fewer.
-                if opened[k].0 <= own {
-                    choice.cost[k - 1] = opened[k].0;
-                    choice.left_slots[k - 1] = opened[k].1;
+                if cost <= own {
+                    choice.cost[k - 1] = cost;
+                    choice.left_slots[k - 1] = left_slots;
                 }
             }
             choices[index] = choice;
