@@ -5,9 +5,11 @@
 //!
 //! Items are binned along all three axes at once and the plane of least
 //! SAH cost C = C_trav + (A_L ⌈N_L/4⌉ + A_R ⌈N_R/4⌉) / A (in units of one
-//! leaf test, which tests up to four triangles at once) is taken; a range
-//! becomes a leaf when that is no cheaper than testing its primitives and
-//! it is small enough for its kind. Leaves never
+//! leaf test, which tests up to four triangles at once) is taken. With
+//! C_trav = 1 a split of a range that fits one block never pays, and any
+//! larger range needs more than one leaf anyway, so a range becomes a leaf
+//! exactly when it fits one block of its kind; no SAH is evaluated for it.
+//! Leaves never
 //! mix primitive kinds (triangles and other shapes are stored apart), and
 //! subtrees deeper than [`MAX_SAH_DEPTH`] fall back to median splits, which
 //! bounds the depth for any input.
@@ -21,7 +23,7 @@
 //! double-precision boxes, so a box can only be larger than what it holds.
 
 use super::bounds::Bounds32;
-use wide::f32x4;
+use wide::{CmpGt, CmpLt, f32x4, i32x4};
 
 /// Bins per axis: 16 is within a few per cent of a full sweep's quality.
 const BIN_COUNT: usize = 16;
@@ -33,6 +35,10 @@ const PARALLEL_THRESHOLD: usize = 8192;
 /// number of *blocks* (primitives tested together; see [`blocks`]), and
 /// splitting a range that fits one block never pays: leaves come out full.
 const TRAVERSAL_COST: f32 = 1.0;
+// `choose_split` makes every range that fits one block a leaf without
+// evaluating the SAH, which is right only while a traversal step costs at
+// least one block.
+const _: () = assert!(TRAVERSAL_COST >= 1.0);
 /// Depth beyond which splits are made at the object median.
 const MAX_SAH_DEPTH: usize = 48;
 /// Most primitives any leaf may hold (the BVH encodes counts 1 to 4).
@@ -171,7 +177,8 @@ pub enum BinaryContent {
 }
 
 /// Builds the binary tree over `items`, reordering them into leaf order;
-/// a leaf of kind k holds at most `max_leaf_size[k]` items (1 to
+/// a leaf of kind k holds at most `max_leaf_size[k]` items (1, 2 or 4:
+/// other sizes are taken as the power of two below, up to
 /// [`MAX_LEAF_SIZE`]). `items` must not be empty.
 pub fn build(items: &mut [BuildItem], max_leaf_size: &[usize]) -> Vec<BinaryNode> {
     let mut nodes = Vec::with_capacity(2 * items.len() / MAX_LEAF_SIZE + 1);
@@ -218,7 +225,8 @@ fn build_into(items: &mut [BuildItem], range: &Range, max_leaf_size: &[usize], n
         content: BinaryContent::Interior { right: 0 },
     });
     let (left_items, right_items) = items.split_at_mut(mid);
-    if left_items.len() + right_items.len() > PARALLEL_THRESHOLD {
+    // (On one thread, building the right subtree apart would only add a copy.)
+    if left_items.len() + right_items.len() > PARALLEL_THRESHOLD && rayon::current_num_threads() > 1 {
         // Build the right subtree on another thread into its own list, then
         // append it with its indices shifted.
         let mut right_nodes = Vec::new();
@@ -246,110 +254,164 @@ fn build_into(items: &mut [BuildItem], range: &Range, max_leaf_size: &[usize], n
 /// and returning both parts' ranges), or `None` to make them a leaf.
 fn choose_split(items: &mut [BuildItem], range: &Range, max_leaf_size: &[usize]) -> Option<(usize, Range, Range)> {
     let count = items.len();
-    if count <= 1 {
-        return None;
+    if count <= 2 * MAX_LEAF_SIZE {
+        // Small enough that kinds matter: separate mixed kinds (each side
+        // then may become a leaf); a range of one kind that fits one block
+        // is a leaf, since a split costs C_trav + (A_L + A_R) / A ≥ 1 block
+        // (areas are never negative), no less than the leaf's one block.
+        let first_kind = items[0].kind;
+        if !items.iter().all(|item| item.kind == first_kind) {
+            return Some(partition(items, range, |item| item.kind == first_kind));
+        }
+        if count <= block_size(first_kind, max_leaf_size) as usize {
+            return None;
+        }
     }
-    let first_kind = items[0].kind;
-    let one_kind = items.iter().all(|item| item.kind == first_kind);
-    // Primitives of the (first) kind tested together: the SAH counts blocks.
-    let block = max_leaf_size.get(first_kind as usize).copied().unwrap_or(1).max(1) as u32;
-    let leaf_allowed = one_kind && count <= block as usize;
-    if !one_kind && count <= 2 * MAX_LEAF_SIZE {
-        // Small and mixed: separate the kinds; each side then may become a leaf.
-        return Some(partition(items, range, |item| item.kind == first_kind));
-    }
+    // From here on the range must be split.
     let extent = range.centroids.extent();
     if range.depth >= MAX_SAH_DEPTH || extent.iter().all(|&e| e <= 0.0) {
         // No plane separates the centroids, or the tree is already deep:
-        // a leaf if allowed, else the object median.
-        return if leaf_allowed {
-            None
-        } else {
-            Some(median_split(items, range, extent))
-        };
-    }
-
-    // Bin every centroid along each axis at once.
-    let mut bins = [[Box4::EMPTY; BIN_COUNT]; 3];
-    let mut counts = [[0u32; BIN_COUNT]; 3];
-    let scale = f32x4::new(std::array::from_fn(|axis| {
-        if axis < 3 && extent[axis] > 0.0 {
-            BIN_COUNT as f32 * (1.0 - 1e-6) / extent[axis]
-        } else {
-            0.0
-        }
-    }));
-    let origin = range.centroids.lower;
-    let last = f32x4::splat((BIN_COUNT - 1) as f32);
-    // Clamped as floats, then truncated in one instruction (cvttps2dq).
-    let bins_of = |item: &BuildItem| -> [i32; 4] {
-        ((item.centroid2() - origin) * scale)
-            .fast_max(f32x4::ZERO)
-            .fast_min(last)
-            .trunc_int()
-            .to_array()
-    };
-    for item in items.iter() {
-        let bin = bins_of(item);
-        for axis in 0..3 {
-            let bin = bin[axis] as usize;
-            bins[axis][bin] = bins[axis][bin].union(&item.bounds);
-            counts[axis][bin] += 1;
-        }
-    }
-
-    // For each axis, sweep from the right for the area and count right of
-    // each plane, then from the left to find the cheapest plane. A plane
-    // after an empty bin splits like the one before it, so only planes
-    // after non-empty bins are evaluated (small ranges have few).
-    let mut best = (f32::INFINITY, 0usize, 0usize);
-    for axis in 0..3 {
-        if extent[axis] <= 0.0 {
-            continue;
-        }
-        let mut right_cost = [0.0f32; BIN_COUNT];
-        let (mut right_bounds, mut right_count, mut cost_so_far) = (Box4::EMPTY, 0u32, 0.0f32);
-        for plane in (1..BIN_COUNT).rev() {
-            if counts[axis][plane] > 0 {
-                right_bounds = right_bounds.union(&bins[axis][plane]);
-                right_count += counts[axis][plane];
-                cost_so_far = right_bounds.half_area() * blocks(right_count, block);
-            }
-            right_cost[plane] = cost_so_far;
-        }
-        let (mut left_bounds, mut left_count) = (Box4::EMPTY, 0u32);
-        for plane in 1..BIN_COUNT {
-            let added = counts[axis][plane - 1];
-            if added == 0 {
-                continue;
-            }
-            left_bounds = left_bounds.union(&bins[axis][plane - 1]);
-            left_count += added;
-            if left_count as usize == count {
-                break;
-            }
-            let cost = left_bounds.half_area() * blocks(left_count, block) + right_cost[plane];
-            if cost < best.0 {
-                best = (cost, axis, plane);
-            }
-        }
-    }
-    let (best_cost, axis, plane) = best;
-    let split_cost = TRAVERSAL_COST + best_cost / range.bounds.half_area().max(f32::MIN_POSITIVE);
-    if leaf_allowed && split_cost >= blocks(count as u32, block) {
-        return None;
-    }
-    if !best_cost.is_finite() {
+        // split at the object median.
         return Some(median_split(items, range, extent));
     }
-    Some(partition(items, range, |item| (bins_of(item)[axis] as usize) < plane))
+    let binning = Binning::new(range, extent);
+    let mut bins = Bins::EMPTY;
+    binning.bin(items, &mut bins);
+    let block_shift = block_size(items[0].kind, max_leaf_size).trailing_zeros();
+    let Some((axis, plane)) = bins.cheapest_plane(count, block_shift) else {
+        return Some(median_split(items, range, extent));
+    };
+    Some(partition(items, range, |item| binning.bins_of(item)[axis] < plane as i32))
 }
 
-/// Leaf tests `count` primitives need, `block` at a time (Embree's
-/// builders count the same way).
+/// How centroids map to bins: bin ⌊(c − origin) · scale⌋ per axis, clamped
+/// to the bins (axes of zero extent put everything in bin 0).
+struct Binning {
+    origin: f32x4,
+    scale: f32x4,
+}
+
+impl Binning {
+    fn new(range: &Range, extent: [f32; 3]) -> Self {
+        Self {
+            origin: range.centroids.lower,
+            scale: f32x4::new(std::array::from_fn(|axis| {
+                if axis < 3 && extent[axis] > 0.0 {
+                    BIN_COUNT as f32 * (1.0 - 1e-6) / extent[axis]
+                } else {
+                    0.0
+                }
+            })),
+        }
+    }
+
+    /// The item's bin on each axis (lane 3: 0). Clamped as floats (a NaN
+    /// becomes 0: maxps returns its second operand), then truncated in one
+    /// instruction (cvttps2dq), which needs no care for values out of
+    /// range once clamped.
+    #[inline(always)]
+    fn bins_of(&self, item: &BuildItem) -> [i32; 4] {
+        ((item.centroid2() - self.origin) * self.scale)
+            .fast_max(f32x4::ZERO)
+            .fast_min(f32x4::splat((BIN_COUNT - 1) as f32))
+            .fast_trunc_int()
+            .to_array()
+    }
+
+    /// Bins every item along the three axes at once.
+    // Out of line (as are the sweep and the partition), so that profiles
+    // show the builder's three phases apart.
+    #[inline(never)]
+    fn bin(&self, items: &[BuildItem], bins: &mut Bins) {
+        for item in items {
+            let bin = self.bins_of(item);
+            for axis in 0..3 {
+                // The mask only tells the compiler the index is in range (it is).
+                let bin = bin[axis] as usize & (BIN_COUNT - 1);
+                bins.bounds[bin][axis] = bins.bounds[bin][axis].union(&item.bounds);
+                bins.counts[bin][axis] += 1;
+            }
+        }
+    }
+}
+
+const _: () = assert!(BIN_COUNT.is_power_of_two());
+
+/// The bins of one range: per bin, per axis, the bounds and number of the
+/// items whose centroid falls in it.
+struct Bins {
+    bounds: [[Box4; 3]; BIN_COUNT],
+    /// Lane `axis` of `counts[bin]`; lane 3 stays 0.
+    counts: [[i32; 4]; BIN_COUNT],
+}
+
+impl Bins {
+    const EMPTY: Bins = Bins {
+        bounds: [[Box4::EMPTY; 3]; BIN_COUNT],
+        counts: [[0; 4]; BIN_COUNT],
+    };
+
+    /// The axis and plane (items in bins below `plane` go left) of least
+    /// SAH cost A_L ⌈N_L/b⌉ + A_R ⌈N_R/b⌉ (b = 2^`block_shift`) among
+    /// planes with items on both sides, or `None` if there is none. The
+    /// three axes are swept together, one per lane; ties go to the lowest
+    /// axis, then the lowest plane.
+    #[inline(never)]
+    fn cheapest_plane(&self, count: usize, block_shift: u32) -> Option<(usize, usize)> {
+        // From the right: the cost of what lies right of each plane.
+        let mut right_cost = [f32x4::ZERO; BIN_COUNT];
+        let (mut right, mut right_count) = ([Box4::EMPTY; 3], i32x4::ZERO);
+        for plane in (1..BIN_COUNT).rev() {
+            right = std::array::from_fn(|axis| right[axis].union(&self.bounds[plane][axis]));
+            right_count += i32x4::new(self.counts[plane]);
+            right_cost[plane] = half_areas(&right) * blocks(right_count, block_shift);
+        }
+        // From the left: each plane's total cost, keeping each axis's cheapest.
+        let total = i32x4::splat(count as i32);
+        let (mut left, mut left_count) = ([Box4::EMPTY; 3], i32x4::ZERO);
+        let (mut best_cost, mut best_plane) = (f32x4::splat(f32::INFINITY), i32x4::ZERO);
+        for (plane, &right_of_plane) in right_cost.iter().enumerate().skip(1) {
+            left = std::array::from_fn(|axis| left[axis].union(&self.bounds[plane - 1][axis]));
+            left_count += i32x4::new(self.counts[plane - 1]);
+            let cost = half_areas(&left) * blocks(left_count, block_shift) + right_of_plane;
+            let splits = left_count.cmp_gt(i32x4::ZERO) & left_count.cmp_lt(total);
+            let better: i32x4 = splits & bytemuck::cast::<f32x4, i32x4>(cost.cmp_lt(best_cost));
+            best_cost = bytemuck::cast::<i32x4, f32x4>(better).blend(cost, best_cost);
+            best_plane = better.blend(i32x4::splat(plane as i32), best_plane);
+        }
+        let (costs, planes) = (best_cost.to_array(), best_plane.to_array());
+        let mut best: Option<(usize, usize)> = None;
+        for (axis, (&cost, &plane)) in costs.iter().zip(&planes).take(3).enumerate() {
+            if cost < best.map_or(f32::INFINITY, |(best_axis, _)| costs[best_axis]) {
+                best = Some((axis, plane as usize));
+            }
+        }
+        best
+    }
+}
+
+/// Half the surface area of each of three boxes, box i in lane i (lane 3:
+/// 0), with the same operations in the same order as [`Box4::half_area`],
+/// so the results are equal to the last bit.
 #[inline(always)]
-fn blocks(count: u32, block: u32) -> f32 {
-    count.div_ceil(block) as f32
+fn half_areas(boxes: &[Box4; 3]) -> f32x4 {
+    let extent = |b: &Box4| (b.upper - b.lower).fast_max(f32x4::ZERO);
+    let [x, y, z, _] = f32x4::transpose([extent(&boxes[0]), extent(&boxes[1]), extent(&boxes[2]), f32x4::ZERO]);
+    x * y + y * z + z * x
+}
+
+/// Leaf tests `count` primitives need per lane, 2^`block_shift` at a time
+/// (Embree's builders count the same way).
+#[inline(always)]
+fn blocks(count: i32x4, block_shift: u32) -> f32x4 {
+    ((count + i32x4::splat((1 << block_shift) - 1)) >> block_shift).round_float()
+}
+
+/// Primitives of `kind` tested together, which the SAH counts as one
+/// block: the kind's leaf size (a power of two, see [`build`]).
+fn block_size(kind: u32, max_leaf_size: &[usize]) -> u32 {
+    let size = max_leaf_size.get(kind as usize).copied().unwrap_or(1).clamp(1, MAX_LEAF_SIZE);
+    1 << size.ilog2()
 }
 
 /// Splits at the median centroid along the widest axis.
@@ -389,6 +451,7 @@ fn largest_axis(extent: [f32; 3]) -> usize {
 
 /// Moves items satisfying `goes_left` to the front, gathering both sides'
 /// bounds and centroid bounds on the way; returns the split and the ranges.
+#[inline(never)]
 fn partition(items: &mut [BuildItem], range: &Range, goes_left: impl Fn(&BuildItem) -> bool) -> (usize, Range, Range) {
     let (mut left_bounds, mut left_centroids) = (Box4::EMPTY, Box4::EMPTY);
     let (mut right_bounds, mut right_centroids) = (Box4::EMPTY, Box4::EMPTY);
@@ -398,7 +461,9 @@ fn partition(items: &mut [BuildItem], range: &Range, goes_left: impl Fn(&BuildIt
         if goes_left(&item) {
             left_bounds = left_bounds.union(&item.bounds);
             left_centroids = left_centroids.include(item.centroid2());
-            items.swap(i, split);
+            // A swap of items `i` and `split`, reusing the copy in registers.
+            items[i] = items[split];
+            items[split] = item;
             split += 1;
         } else {
             right_bounds = right_bounds.union(&item.bounds);

@@ -18,6 +18,7 @@
 
 use super::bounds::{Bounds32, round_up};
 use super::build::{self, BinaryContent, BinaryNode, Box4, BuildItem, MAX_LEAF_SIZE};
+use super::collapse::Collapse;
 use crate::math::{Aabb, Ray};
 use arrayvec::ArrayVec;
 use wide::{CmpLe, f32x4};
@@ -137,8 +138,8 @@ impl Bvh {
     }
 
     /// As [`Bvh::build`], with leaves of kind k holding at most
-    /// `max_leaf_size[k]` primitives (1 to 4): 1 suits primitives whose
-    /// test costs far more than a box test.
+    /// `max_leaf_size[k]` primitives (1, 2 or 4; 3 is taken as 2): 1 suits
+    /// primitives whose test costs far more than a box test.
     pub fn build_with_leaf_sizes(
         primitives: &[BuildPrimitive],
         max_leaf_size: [usize; KIND_COUNT],
@@ -171,6 +172,7 @@ impl Bvh {
 
         let mut collapser = Collapser {
             binary: &binary,
+            collapse: Collapse::new(&binary),
             index_within_kind: &index_within_kind,
             nodes: Vec::with_capacity(binary.len() / 2 + 1),
             leaf_count: 0,
@@ -480,9 +482,10 @@ impl TraversalRay {
     }
 }
 
-/// Turns the binary tree into four-wide nodes, depth first.
+/// Turns the binary tree into four-wide nodes, depth first, as [`Collapse`] plans.
 struct Collapser<'a> {
     binary: &'a [BinaryNode],
+    collapse: Collapse<'a>,
     index_within_kind: &'a [u32],
     nodes: Vec<Node>,
     leaf_count: usize,
@@ -494,31 +497,10 @@ impl Collapser<'_> {
     /// a binary leaf at the root, a node with that one leaf) and returns its index.
     fn node(&mut self, index: usize, depth: usize) -> u32 {
         self.depth = self.depth.max(depth);
-        // Open the binary subtree: repeatedly replace the interior child of
-        // largest area by its two children, up to four children.
-        let mut children = ArrayVec::<usize, WIDTH>::new();
-        match self.binary[index].content {
-            BinaryContent::Leaf { .. } => children.push(index),
-            BinaryContent::Interior { right } => children.extend([index + 1, right as usize]),
-        }
-        while children.len() < WIDTH {
-            let widest = children
-                .iter()
-                .enumerate()
-                .filter(|&(_, &child)| matches!(self.binary[child].content, BinaryContent::Interior { .. }))
-                .max_by(|a, b| {
-                    let area = |i: usize| self.binary[i].bounds.half_area();
-                    area(*a.1).total_cmp(&area(*b.1))
-                })
-                .map(|(slot, _)| slot);
-            let Some(slot) = widest else { break };
-            let opened = children[slot];
-            let BinaryContent::Interior { right } = self.binary[opened].content else {
-                break;
-            };
-            children[slot] = opened + 1;
-            children.push(right as usize);
-        }
+        let children = match self.binary[index].content {
+            BinaryContent::Leaf { .. } => ArrayVec::from_iter([index]),
+            BinaryContent::Interior { .. } => self.collapse.children(index),
+        };
 
         let me = self.nodes.len();
         self.nodes.push(Node::EMPTY);

@@ -3,11 +3,13 @@
 //! caller's closure.
 //!
 //! - [`build`]: the binned-SAH binary tree builder;
+//! - [`collapse`]: which binary nodes become four-wide nodes;
 //! - [`bvh`]: the four-wide tree collapsed from it, and its traversal;
 //! - [`bounds`]: the outward-rounded single-precision boxes both use.
 
 pub mod bounds;
 pub mod build;
 pub mod bvh;
+pub mod collapse;
 
 pub use bvh::{BuildPrimitive, Bvh, Leaf, TraversalRay};
