@@ -5,47 +5,13 @@
 //! and for BSDF sampling alike; the example scene renders.
 
 mod common;
-use common::{Job, render, scene, shipped_scene};
+use common::{Job, render, shipped_scene, wall};
 use prism::color::Color;
 use prism::render::IntegratorKind;
 use prism::spectrum::cie::{GridPosition, matching};
 use prism::spectrum::sensor::{D65_CHROMATICITY, Sensor, chromaticity};
 use prism::spectrum::uplift::{Basis, spectrum_table_of_rgb};
 use prism::spectrum::{EmissionSpectrum, LAMBDA_MAX, LAMBDA_MIN, SpectrumSource, StandardIlluminant};
-
-/// A diffuse wall (at z = 0, facing the camera, filling the view) under a
-/// square light above and in front of it; `ALBEDO` and `LIGHT` are replaced.
-/// Every path is one bounce: off the wall to the light, or out.
-const WALL: &str = r#"
-[camera]
-position = [0, 0, 3]
-look_at = [0, 0, 0]
-fov_y_degrees = 30
-
-[materials.wall]
-type = "diffuse"
-albedo = ALBEDO
-[materials.light]
-type = "emissive"
-LIGHT
-
-[[objects]]
-type = "quad"
-corner = [-2, -2, 0]
-edge_u = [4, 0, 0]
-edge_v = [0, 4, 0]
-material = "wall"
-[[objects]]
-type = "quad"
-corner = [-0.5, 2, 0.5]
-edge_u = [1, 0, 0]
-edge_v = [0, 0, 1]
-material = "light"
-"#;
-
-fn wall(albedo: &str, light: &str) -> prism::scene::LoadedScene {
-    scene(&WALL.replace("ALBEDO", albedo).replace("LIGHT", light))
-}
 
 /// Per channel, the mean and standard error over seeds 1..=runs of
 /// `statistic(spectral image means, RGB image means)`, the two renders

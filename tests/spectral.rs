@@ -4,7 +4,7 @@
 //! two path-tracing estimators agreeing, and determinism across threads.
 
 mod common;
-use common::{Job, assert_estimators_agree, render, scene, shipped_scene};
+use common::{Job, assert_estimators_agree, render, scene, shipped_scene, wall};
 use prism::render::IntegratorKind;
 use prism::spectrum::sensor::{D65_CHROMATICITY, chromaticity};
 
@@ -65,34 +65,6 @@ fn spectral_white_furnace_is_one() {
     }
 }
 
-/// A white diffuse wall facing a white square light, nothing else.
-const WHITE_WALL: &str = r#"
-[camera]
-position = [0, 0, 3]
-look_at = [0, 0, 0]
-fov_y_degrees = 30
-
-[materials.wall]
-type = "diffuse"
-albedo = [0.8, 0.8, 0.8]
-[materials.light]
-type = "emissive"
-radiance = [5, 5, 5]
-
-[[objects]]
-type = "quad"   # the wall at z = 0, facing +z
-corner = [-2, -2, 0]
-edge_u = [4, 0, 0]
-edge_v = [0, 4, 0]
-material = "wall"
-[[objects]]
-type = "quad"   # the light above and in front, facing down
-corner = [-0.5, 2, 0.5]
-edge_u = [1, 0, 0]
-edge_v = [0, 0, 1]
-material = "light"
-"#;
-
 /// Under an RGB-white light a white wall must come out neutral: the image's
 /// mean colour lies within 0.002 of the film's white point (D65, RGB
 /// (1, 1, 1)) in CIE xy, the issue's tolerance. Colour noise from the
@@ -100,7 +72,7 @@ material = "light"
 /// effect on the mean chromaticity is about 10⁻⁴.
 #[test]
 fn a_white_wall_under_a_white_light_is_neutral() {
-    let loaded = scene(WHITE_WALL);
+    let loaded = wall("[0.8, 0.8, 0.8]", "radiance = [5, 5, 5]");
     let frame = render(
         &loaded,
         &Job {

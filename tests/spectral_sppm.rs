@@ -4,40 +4,9 @@
 //! light), for neutrality, and for determinism across thread counts.
 
 mod common;
-use common::{Job, render, scene, shipped_scene};
+use common::{Job, render, shipped_scene, wall};
 use prism::render::IntegratorKind;
 use prism::spectrum::sensor::{D65_CHROMATICITY, chromaticity};
-
-/// A grey wall facing a white square light, nothing else.
-const WHITE_WALL: &str = r#"
-[camera]
-position = [0, 0, 3]
-look_at = [0, 0, 0]
-fov_y_degrees = 30
-
-[render]
-photons_per_iteration = 80000
-
-[materials.wall]
-type = "diffuse"
-albedo = [0.8, 0.8, 0.8]
-[materials.light]
-type = "emissive"
-radiance = [5, 5, 5]
-
-[[objects]]
-type = "quad"   # the wall at z = 0, facing +z
-corner = [-2, -2, 0]
-edge_u = [4, 0, 0]
-edge_v = [0, 4, 0]
-material = "wall"
-[[objects]]
-type = "quad"   # the light above and in front, facing down
-corner = [-0.5, 2, 0.5]
-edge_u = [1, 0, 0]
-edge_v = [0, 0, 1]
-material = "light"
-"#;
 
 /// With grey surfaces and a white light every spectrum is flat, so a
 /// spectral photon's contribution is the RGB photon's (same seed, same
@@ -51,7 +20,9 @@ material = "light"
 /// the issue's 0.002 in xy.
 #[test]
 fn spectral_sppm_matches_rgb_sppm_on_grey_surfaces_and_stays_neutral() {
-    let loaded = scene(WHITE_WALL);
+    // A grey wall facing a white square light, nothing else.
+    let mut loaded = wall("[0.8, 0.8, 0.8]", "radiance = [5, 5, 5]");
+    loaded.settings.sppm.photons_per_iteration = 80_000;
     let job = Job {
         width: 24,
         height: 24,

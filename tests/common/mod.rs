@@ -135,3 +135,38 @@ pub fn assert_estimators_agree(loaded: &LoadedScene, job: Job, min_mean: f64, ma
         );
     }
 }
+
+/// A diffuse wall (at z = 0, facing the camera, filling the view) under a
+/// square light above and in front of it; `ALBEDO` and `LIGHT` are replaced.
+/// Every path is one bounce: off the wall to the light, or out.
+pub const WALL: &str = r#"
+[camera]
+position = [0, 0, 3]
+look_at = [0, 0, 0]
+fov_y_degrees = 30
+
+[materials.wall]
+type = "diffuse"
+albedo = ALBEDO
+[materials.light]
+type = "emissive"
+LIGHT
+
+[[objects]]
+type = "quad"
+corner = [-2, -2, 0]
+edge_u = [4, 0, 0]
+edge_v = [0, 4, 0]
+material = "wall"
+[[objects]]
+type = "quad"
+corner = [-0.5, 2, 0.5]
+edge_u = [1, 0, 0]
+edge_v = [0, 0, 1]
+material = "light"
+"#;
+
+/// The wall scene with its albedo (`[r, g, b]`) and light (a `radiance = …` or spectrum line).
+pub fn wall(albedo: &str, light: &str) -> LoadedScene {
+    scene(&WALL.replace("ALBEDO", albedo).replace("LIGHT", light))
+}
