@@ -8,7 +8,7 @@
 //! when the scene loads. Both forms have the same expectation: the spectral
 //! estimator (1/N) Σ L(λᵢ) x̄(λᵢ)/p(λᵢ) of a piecewise-linear L is, on
 //! average, exactly the grid integral the RGB is made of. So an RGB render
-//! (and SPPM, which carries RGB) shows a spectral emitter in the mean as a
+//! (path tracing or SPPM) shows a spectral emitter in the mean as a
 //! spectral render does; only what it lights through coloured surfaces
 //! differs, as products of spectra differ from products of RGBs.
 //!
