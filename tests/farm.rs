@@ -101,9 +101,10 @@ fn adaptive_parts_merge_into_one_run() {
     );
 }
 
-#[test]
-fn global_schedule_sppm_parts_merge_into_one_run() {
-    let mut loaded = shipped_scene("caustic.toml");
+/// A shipped scene set up for small global-schedule SPPM farm renders:
+/// 16×12, 7 iterations of 4,000 photons, seed 5.
+fn global_sppm(name: &str) -> (LoadedScene, RenderSettings) {
+    let mut loaded = shipped_scene(name);
     loaded.settings.sppm.photons_per_iteration = 4_000;
     loaded.settings.sppm.radius_schedule = RadiusSchedule::Global;
     let settings = RenderSettings {
@@ -114,6 +115,12 @@ fn global_schedule_sppm_parts_merge_into_one_run() {
         seed: 5,
         ..loaded.settings.clone()
     };
+    (loaded, settings)
+}
+
+#[test]
+fn global_schedule_sppm_parts_merge_into_one_run() {
+    let (loaded, settings) = global_sppm("caustic.toml");
     let whole = check_parts_merge_exactly(&loaded, &settings, "sppm/global");
     // Each iteration is one sample of every pixel: the mean is of 7 estimates.
     assert!(whole.pixels.iter().all(|p| p.count == 7));
@@ -124,19 +131,9 @@ fn global_schedule_sppm_parts_merge_into_one_run() {
 /// dispersive scene.
 #[test]
 fn spectral_global_schedule_sppm_parts_merge_into_one_run() {
-    let mut loaded = shipped_scene("dispersion.toml");
+    let (loaded, mut settings) = global_sppm("dispersion.toml");
     assert!(loaded.scene.has_dispersion());
-    loaded.settings.sppm.photons_per_iteration = 4_000;
-    loaded.settings.sppm.radius_schedule = RadiusSchedule::Global;
-    let settings = RenderSettings {
-        width: 16,
-        height: 12,
-        samples_per_pixel: Some(7),
-        integrator: IntegratorKind::Sppm,
-        max_depth: 8,
-        seed: 5,
-        ..loaded.settings.clone()
-    };
+    settings.max_depth = 8;
     let whole = check_parts_merge_exactly(&loaded, &settings, "spectral sppm/global");
     assert!(whole.frame().channel_means().iter().all(|&m| m > 0.0), "SPPM saw no light");
 }

@@ -5,42 +5,13 @@
 //! and for BSDF sampling alike; the example scene renders.
 
 mod common;
-use common::{Job, render, shipped_scene, wall};
+use common::{Job, paired, render, shipped_scene, wall};
 use prism::color::Color;
 use prism::render::IntegratorKind;
 use prism::spectrum::cie::{GridPosition, matching};
 use prism::spectrum::sensor::{D65_CHROMATICITY, Sensor, chromaticity};
 use prism::spectrum::uplift::{Basis, spectrum_table_of_rgb};
 use prism::spectrum::{EmissionSpectrum, LAMBDA_MAX, LAMBDA_MIN, SpectrumSource, StandardIlluminant};
-
-/// Per channel, the mean and standard error over seeds 1..=runs of
-/// `statistic(spectral image means, RGB image means)`, the two renders
-/// paired by seed. Spectral paths take their wavelengths from a side stream,
-/// so a pair traces the same paths and differs only by what the
-/// wavelengths carry: the paired statistic is far less noisy than either.
-fn paired(loaded: &prism::scene::LoadedScene, job: Job, runs: u64, statistic: fn(f64, f64) -> f64) -> [(f64, f64); 3] {
-    let values: Vec<[f64; 3]> = (1..=runs)
-        .map(|seed| {
-            let rgb = render(loaded, &Job { seed, ..job }).channel_means();
-            let spectral = render(
-                loaded,
-                &Job {
-                    seed,
-                    spectral: true,
-                    ..job
-                },
-            )
-            .channel_means();
-            std::array::from_fn(|c| statistic(spectral[c], rgb[c]))
-        })
-        .collect();
-    let n = runs as f64;
-    std::array::from_fn(|c| {
-        let mean = values.iter().map(|v| v[c]).sum::<f64>() / n;
-        let variance = values.iter().map(|v| (v[c] - mean).powi(2)).sum::<f64>() / (n - 1.0);
-        (mean, (variance / n).sqrt())
-    })
-}
 
 /// A white wall lit by D65 has, through the film, the chromaticity of
 /// D65's film RGB (predicted from the CIE tables, `EmissionSpectrum::rgb`):

@@ -4,7 +4,7 @@
 //! two path-tracing estimators agreeing, and determinism across threads.
 
 mod common;
-use common::{Job, assert_estimators_agree, render, scene, shipped_scene, wall};
+use common::{Job, assert_estimators_agree, paired, render, scene, shipped_scene, wall};
 use prism::render::IntegratorKind;
 use prism::spectrum::sensor::{D65_CHROMATICITY, chromaticity};
 
@@ -106,26 +106,7 @@ fn spectral_minus_rgb(loaded: &prism::scene::LoadedScene, runs: u64) -> [(f64, f
         max_depth: 16,
         ..Job::default()
     };
-    let differences: Vec<[f64; 3]> = (1..=runs)
-        .map(|seed| {
-            let rgb = render(loaded, &Job { seed, ..job }).channel_means();
-            let spectral = render(
-                loaded,
-                &Job {
-                    seed,
-                    spectral: true,
-                    ..job
-                },
-            )
-            .channel_means();
-            std::array::from_fn(|c| spectral[c] / rgb[c] - 1.0)
-        })
-        .collect();
-    std::array::from_fn(|c| {
-        let mean = differences.iter().map(|d| d[c]).sum::<f64>() / runs as f64;
-        let variance = differences.iter().map(|d| (d[c] - mean).powi(2)).sum::<f64>() / (runs as f64 - 1.0);
-        (mean, (variance / runs as f64).sqrt())
-    })
+    paired(loaded, job, runs, |spectral, rgb| spectral / rgb - 1.0)
 }
 
 /// Spectral against RGB on the Cornell box (mirror and glass balls, no

@@ -170,3 +170,32 @@ material = "light"
 pub fn wall(albedo: &str, light: &str) -> LoadedScene {
     scene(&WALL.replace("ALBEDO", albedo).replace("LIGHT", light))
 }
+
+/// Per channel, the mean and standard error over seeds 1..=runs of
+/// `statistic(spectral image means, RGB image means)`, the two renders
+/// paired by seed. Spectral paths take their wavelengths from a side stream,
+/// so a pair traces the same paths and differs only by what the
+/// wavelengths carry: the paired statistic is far less noisy than either.
+pub fn paired(loaded: &LoadedScene, job: Job, runs: u64, statistic: fn(f64, f64) -> f64) -> [(f64, f64); 3] {
+    let values: Vec<[f64; 3]> = (1..=runs)
+        .map(|seed| {
+            let rgb = render(loaded, &Job { seed, ..job }).channel_means();
+            let spectral = render(
+                loaded,
+                &Job {
+                    seed,
+                    spectral: true,
+                    ..job
+                },
+            )
+            .channel_means();
+            std::array::from_fn(|c| statistic(spectral[c], rgb[c]))
+        })
+        .collect();
+    let n = runs as f64;
+    std::array::from_fn(|c| {
+        let mean = values.iter().map(|v| v[c]).sum::<f64>() / n;
+        let variance = values.iter().map(|v| (v[c] - mean).powi(2)).sum::<f64>() / (n - 1.0);
+        (mean, (variance / n).sqrt())
+    })
+}
