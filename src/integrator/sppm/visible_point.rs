@@ -65,7 +65,26 @@ pub struct CameraPath {
 
 /// Traces `ray` through up to `max_depth` specular bounces, carrying RGB
 /// or the wavelengths `C` draws from `sampler`'s side stream.
-pub fn trace_camera_path<C: Radiance>(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, max_depth: u32) -> CameraPath {
+pub fn trace_camera_path<C: Radiance>(scene: &Scene, ray: Ray, sampler: &mut Sampler, max_depth: u32) -> CameraPath {
+    trace::<C, true>(scene, ray, sampler, max_depth)
+}
+
+/// The emission [`trace_camera_path`] would find along the same path (the
+/// same draws, the same sums), without building the visible point at its
+/// end: the extra emission-only paths of a pixel need no shading frame there.
+pub fn trace_emission_path<C: Radiance>(scene: &Scene, ray: Ray, sampler: &mut Sampler, max_depth: u32) -> Color {
+    trace::<C, false>(scene, ray, sampler, max_depth).emitted
+}
+
+/// Both of the above; `VISIBLE_POINT` says whether to record where the path
+/// ends (a constant, so each caller gets its own loop without the other's work).
+#[inline(always)]
+fn trace<C: Radiance, const VISIBLE_POINT: bool>(
+    scene: &Scene,
+    mut ray: Ray,
+    sampler: &mut Sampler,
+    max_depth: u32,
+) -> CameraPath {
     let mut wavelengths = C::sample_wavelengths(sampler);
     let mut visible_point = None;
     let mut emitted = C::ZERO;
@@ -87,7 +106,7 @@ pub fn trace_camera_path<C: Radiance>(scene: &Scene, mut ray: Ray, sampler: &mut
             .emission_towards(hit.geometric_normal.dot(wo_world))
             .unwrap_or(Emission::NONE);
         emitted += throughput * C::emission(emission, &wavelengths);
-        if !material.scatters() {
+        if !material.scatters() || (!VISIBLE_POINT && !material.is_specular()) {
             break;
         }
         let frame = ShadingFrame::from_normal(hit.shading_normal);
