@@ -124,6 +124,16 @@ impl Sampler {
         }
     }
 
+    /// Passes over one draw (1D or 2D) without computing it, for a value
+    /// nothing would read: each draw is a pure function of its dimension,
+    /// so every later draw is the one it would have been. Lets a caller that
+    /// keeps a fixed sequence of dimensions (the lens of a pinhole camera,
+    /// the lobe choice of a diffuse bounce) skip the Sobol' arithmetic.
+    #[inline]
+    pub fn skip(&mut self) {
+        self.dimension += 1;
+    }
+
     /// The per-dimension shuffle of the sample index, nested_uniform_scramble(index, seed).
     #[inline]
     fn shuffled_index(&self, seed: u32) -> u32 {
@@ -282,6 +292,36 @@ mod tests {
             let x = nested_uniform_scramble(index.reverse_bits(), scramble as u32);
             let y = nested_uniform_scramble(sobol_second_dimension(index), (scramble >> 32) as u32);
             assert_eq!(fast.next_2d(), DVec2::new(to_unit(x), to_unit(y)));
+        }
+    }
+
+    /// Skipping a draw leaves every later draw as it was, for both kinds,
+    /// whether the skipped draw was 1D or 2D and Sobol' or independent
+    /// (the SPPM images stay bit for bit the same only if this holds).
+    #[test]
+    fn skipped_draws_leave_later_draws_unchanged() {
+        for kind in [SamplerKind::Sobol, SamplerKind::Random] {
+            for skipped in 0..14 {
+                let mut drawn = Sampler::new(kind, 21, 6, 9);
+                let mut skipping = drawn.clone();
+                for dimension in 0..16 {
+                    // Alternate 2D and 1D draws, as paths do.
+                    let draw = |s: &mut Sampler| match dimension % 2 {
+                        0 => s.next_2d(),
+                        _ => DVec2::splat(s.next_1d()),
+                    };
+                    let expected = draw(&mut drawn);
+                    if dimension == skipped {
+                        skipping.skip();
+                    } else {
+                        assert_eq!(
+                            draw(&mut skipping),
+                            expected,
+                            "{kind}: dimension {dimension}, {skipped} skipped"
+                        );
+                    }
+                }
+            }
         }
     }
 

@@ -16,8 +16,8 @@
 //! the two sides in sensor RGB).
 
 use crate::color::Color;
-use crate::material::{ShadingPoint, Transport};
-use crate::math::{DVec3, Frame as ShadingFrame, Ray};
+use crate::material::{Material, ShadingPoint, Transport};
+use crate::math::{DVec2, DVec3, Frame as ShadingFrame, Ray};
 use crate::sampler::Sampler;
 use crate::scene::Scene;
 use crate::spectrum::{Emission, Radiance};
@@ -132,9 +132,9 @@ fn trace<C: Radiance, const VISIBLE_POINT: bool>(
             });
             break;
         }
-        // Mirror or glass: follow the one sampled direction.
-        let u = sampler.next_2d();
-        let u_lobe = sampler.next_1d();
+        // Mirror or glass: follow the one sampled direction. Both draws keep
+        // their dimensions, but only those the BSDF reads are computed.
+        let (u, u_lobe) = bsdf_inputs(material, sampler);
         let Some(sample) = C::sample_bsdf(material, wo, &at, u, u_lobe, Transport::Radiance, &mut wavelengths) else {
             break;
         };
@@ -149,4 +149,27 @@ fn trace<C: Radiance, const VISIBLE_POINT: bool>(
         emitted: emitted.to_rgb(&wavelengths),
         visible_point,
     }
+}
+
+/// The direction and lobe samples for scattering off `material`, drawn as
+/// two dimensions of `sampler` always (a 2D and a 1D draw, so the stream's
+/// later draws do not depend on the material), but computed only where
+/// [`Material::sample_inputs`] says the BSDF reads them; the rest are
+/// placeholders it ignores. The values it reads are those plain draws give.
+#[inline]
+pub fn bsdf_inputs(material: &Material, sampler: &mut Sampler) -> (DVec2, f64) {
+    let (uses_direction, uses_lobe) = material.sample_inputs();
+    let u = if uses_direction {
+        sampler.next_2d()
+    } else {
+        sampler.skip();
+        DVec2::ZERO
+    };
+    let u_lobe = if uses_lobe {
+        sampler.next_1d()
+    } else {
+        sampler.skip();
+        0.5
+    };
+    (u, u_lobe)
 }
