@@ -88,6 +88,13 @@ impl Camera {
         self.basis.up
     }
 
+    /// Whether rays start on a lens (a finite aperture): a pinhole camera's
+    /// [`generate_ray`](Self::generate_ray) ignores its lens sample.
+    #[inline]
+    pub fn has_lens(&self) -> bool {
+        self.aperture_radius > 0.0 || self.aperture_radius.is_nan()
+    }
+
     /// Primary ray through `film` ∈ \[0,1\]² (x right, y down) for an image of
     /// the given aspect ratio (width / height); `lens` ∈ \[0,1\]² picks the
     /// point on the aperture.
@@ -99,13 +106,13 @@ impl Camera {
         // Direction with unit forward component: `focal_distance` along it
         // lands on the focal plane.
         let direction = b.forward + x * b.right + y * b.up;
-        let mut ray = if self.aperture_radius <= 0.0 {
-            Ray::new(self.position, direction)
-        } else {
+        let mut ray = if self.has_lens() {
             let focus = self.position + self.focal_distance * direction;
             let disk = warp::square_to_concentric_disk(lens) * self.aperture_radius;
             let origin = self.position + disk.x * b.right + disk.y * b.up;
             Ray::new(origin, focus - origin)
+        } else {
+            Ray::new(self.position, direction)
         };
         if self.near_clip > 0.0 {
             ray.origin += ray.direction * (self.near_clip / ray.direction.dot(b.forward));

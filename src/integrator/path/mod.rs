@@ -82,7 +82,14 @@ impl PathIntegrator {
 /// dimensions (film position within the pixel: a box filter, and lens).
 pub fn camera_ray(camera: &Camera, (width, height): (u32, u32), x: u32, y: u32, sampler: &mut Sampler) -> Ray {
     let jitter = sampler.next_2d();
-    let lens = sampler.next_2d();
+    // A pinhole reads no lens sample; its dimension is still used up, so
+    // later draws do not depend on the camera.
+    let lens = if camera.has_lens() {
+        sampler.next_2d()
+    } else {
+        sampler.skip();
+        DVec2::ZERO
+    };
     let film_point = DVec2::new((x as f64 + jitter.x) / width as f64, (y as f64 + jitter.y) / height as f64);
     camera.generate_ray(film_point, width as f64 / height as f64, lens)
 }

@@ -59,7 +59,7 @@ use statistics::{PhotonTally, PixelStatistics};
 use std::f64::consts::PI;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
-use visible_point::{VisiblePoint, trace_camera_path};
+use visible_point::{VisiblePoint, trace_camera_path, trace_emission_path};
 
 /// Mixed into the seed of photon streams so they never share a stream with
 /// the camera paths of the same index and iteration.
@@ -235,7 +235,7 @@ impl SppmIntegrator {
                     seed ^ EMISSION_SEED,
                 );
                 let ray = camera_ray(camera, size, x, y, &mut sampler);
-                emitted += trace_camera_path::<C>(scene, ray, &mut sampler, max_depth).emitted;
+                emitted += trace_emission_path::<C>(scene, ray, &mut sampler, max_depth);
             }
             let emitted = emitted / EMISSION_SAMPLES as f64;
             CameraSample {

@@ -20,6 +20,7 @@
 //! other draws are those of an RGB photon); a dispersive interface sends it
 //! on at its hero wavelength only, as for camera paths.
 
+use super::visible_point::bsdf_inputs;
 use crate::color::{Color, luminance};
 use crate::geometry::SurfaceHit;
 use crate::light::EmitterSource;
@@ -127,7 +128,15 @@ fn emit_from_shape<C: Radiance>(
     let emitter = scene.emitter(light.primitive);
     let on_light = emitter.sample_area(sampler.next_2d());
     let local = warp::square_to_cosine_hemisphere(sampler.next_2d());
-    let side = sampler.next_1d();
+    // The side is drawn for one-sided lights too (so the draws after it
+    // keep their dimensions), but only computed for two-sided ones.
+    let side = match light.two_sided {
+        true => sampler.next_1d(),
+        false => {
+            sampler.skip();
+            0.5
+        }
+    };
     let (normal, side_probability) = match light.two_sided {
         true if side < 0.5 => (-on_light.normal, 0.5),
         true => (on_light.normal, 0.5),
@@ -210,8 +219,7 @@ pub fn trace<C: Radiance>(
             uv: hit.uv,
             point: hit.point,
         };
-        let u = sampler.next_2d();
-        let u_lobe = sampler.next_1d();
+        let (u, u_lobe) = bsdf_inputs(material, sampler);
         let wo = frame.to_local(towards_light);
         let Some(sample) = C::sample_bsdf(material, wo, &at, u, u_lobe, Transport::Importance, &mut wavelengths) else {
             return;

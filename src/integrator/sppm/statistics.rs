@@ -82,7 +82,7 @@ impl PhotonTally {
     pub fn add(&self, flux: Color, inverse_unit: f64) {
         for (channel, value) in self.flux.iter().zip(flux.to_array()) {
             let units = (value * inverse_unit).clamp(-MAX_UNITS_PER_PHOTON, MAX_UNITS_PER_PHOTON);
-            let fixed = (units * FIXED_POINT_ONE).round() as i64;
+            let fixed = round_half_away_from_zero(units * FIXED_POINT_ONE);
             if fixed != 0 {
                 channel.fetch_add(fixed, Ordering::Relaxed);
             }
@@ -100,9 +100,67 @@ impl PhotonTally {
     }
 }
 
+/// `x.round() as i64` for |x| < 2⁶³, without `round`'s library call (the
+/// x86-64 baseline has no SSE4.1 rounding instruction), in a loop that runs
+/// for every photon a visible point gathers. The cast truncates; `x - t` is
+/// exact (t is x with its fraction bits cleared, or x itself beyond 2⁵²), so
+/// comparing it with ±½ rounds halves away from zero exactly as `round` does.
+#[inline]
+fn round_half_away_from_zero(x: f64) -> i64 {
+    let truncated = x as i64;
+    let fraction = x - truncated as f64;
+    if fraction >= 0.5 {
+        truncated + 1
+    } else if fraction <= -0.5 {
+        truncated - 1
+    } else {
+        truncated
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The same integers as `f64::round`, at halves, next to halves, at
+    /// large magnitudes and at zero (the tally's clamp keeps |x| ≤ 2⁵²).
+    #[test]
+    fn rounding_matches_the_standard_library() {
+        let mut values = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.5,
+            -1.5,
+            2.5,
+            -2.5,
+            0.49999999999999994,
+            -0.49999999999999994,
+        ];
+        values.extend([
+            1e6 * FIXED_POINT_ONE,
+            -1e6 * FIXED_POINT_ONE,
+            4503599627370495.5,
+            -4503599627370495.5,
+        ]);
+        let mut state = 0x1234_5678_9abc_def0u64;
+        for _ in 0..100_000 {
+            state = crate::sampler::mix64(state);
+            // Magnitudes from 2⁻¹⁰ to 2⁵² and both signs.
+            let scale = 2f64.powi((state % 63) as i32 - 10);
+            let x = ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2.0 * scale;
+            values.extend([x, x.trunc() + 0.5, x.trunc() - 0.5]);
+        }
+        for x in values {
+            let expected = x.round() as i64;
+            assert_eq!(round_half_away_from_zero(x), expected, "{x:e}");
+            let nudged = [x.next_up(), x.next_down()];
+            for y in nudged {
+                assert_eq!(round_half_away_from_zero(y), y.round() as i64, "{y:e}");
+            }
+        }
+    }
 
     #[test]
     fn radius_shrinks_by_the_paper_ratio_and_tau_follows_the_area() {

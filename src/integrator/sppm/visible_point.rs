@@ -16,8 +16,8 @@
 //! the two sides in sensor RGB).
 
 use crate::color::Color;
-use crate::material::{ShadingPoint, Transport};
-use crate::math::{DVec3, Frame as ShadingFrame, Ray};
+use crate::material::{Material, ShadingPoint, Transport};
+use crate::math::{DVec2, DVec3, Frame as ShadingFrame, Ray};
 use crate::sampler::Sampler;
 use crate::scene::Scene;
 use crate::spectrum::{Emission, Radiance};
@@ -65,7 +65,26 @@ pub struct CameraPath {
 
 /// Traces `ray` through up to `max_depth` specular bounces, carrying RGB
 /// or the wavelengths `C` draws from `sampler`'s side stream.
-pub fn trace_camera_path<C: Radiance>(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, max_depth: u32) -> CameraPath {
+pub fn trace_camera_path<C: Radiance>(scene: &Scene, ray: Ray, sampler: &mut Sampler, max_depth: u32) -> CameraPath {
+    trace::<C, true>(scene, ray, sampler, max_depth)
+}
+
+/// The emission [`trace_camera_path`] would find along the same path (the
+/// same draws, the same sums), without building the visible point at its
+/// end: the extra emission-only paths of a pixel need no shading frame there.
+pub fn trace_emission_path<C: Radiance>(scene: &Scene, ray: Ray, sampler: &mut Sampler, max_depth: u32) -> Color {
+    trace::<C, false>(scene, ray, sampler, max_depth).emitted
+}
+
+/// Both of the above; `VISIBLE_POINT` says whether to record where the path
+/// ends (a constant, so each caller gets its own loop without the other's work).
+#[inline(always)]
+fn trace<C: Radiance, const VISIBLE_POINT: bool>(
+    scene: &Scene,
+    mut ray: Ray,
+    sampler: &mut Sampler,
+    max_depth: u32,
+) -> CameraPath {
     let mut wavelengths = C::sample_wavelengths(sampler);
     let mut visible_point = None;
     let mut emitted = C::ZERO;
@@ -87,7 +106,7 @@ pub fn trace_camera_path<C: Radiance>(scene: &Scene, mut ray: Ray, sampler: &mut
             .emission_towards(hit.geometric_normal.dot(wo_world))
             .unwrap_or(Emission::NONE);
         emitted += throughput * C::emission(emission, &wavelengths);
-        if !material.scatters() {
+        if !material.scatters() || (!VISIBLE_POINT && !material.is_specular()) {
             break;
         }
         let frame = ShadingFrame::from_normal(hit.shading_normal);
@@ -113,9 +132,9 @@ pub fn trace_camera_path<C: Radiance>(scene: &Scene, mut ray: Ray, sampler: &mut
             });
             break;
         }
-        // Mirror or glass: follow the one sampled direction.
-        let u = sampler.next_2d();
-        let u_lobe = sampler.next_1d();
+        // Mirror or glass: follow the one sampled direction. Both draws keep
+        // their dimensions, but only those the BSDF reads are computed.
+        let (u, u_lobe) = bsdf_inputs(material, sampler);
         let Some(sample) = C::sample_bsdf(material, wo, &at, u, u_lobe, Transport::Radiance, &mut wavelengths) else {
             break;
         };
@@ -130,4 +149,27 @@ pub fn trace_camera_path<C: Radiance>(scene: &Scene, mut ray: Ray, sampler: &mut
         emitted: emitted.to_rgb(&wavelengths),
         visible_point,
     }
+}
+
+/// The direction and lobe samples for scattering off `material`, drawn as
+/// two dimensions of `sampler` always (a 2D and a 1D draw, so the stream's
+/// later draws do not depend on the material), but computed only where
+/// [`Material::sample_inputs`] says the BSDF reads them; the rest are
+/// placeholders it ignores. The values it reads are those plain draws give.
+#[inline]
+pub fn bsdf_inputs(material: &Material, sampler: &mut Sampler) -> (DVec2, f64) {
+    let (uses_direction, uses_lobe) = material.sample_inputs();
+    let u = if uses_direction {
+        sampler.next_2d()
+    } else {
+        sampler.skip();
+        DVec2::ZERO
+    };
+    let u_lobe = if uses_lobe {
+        sampler.next_1d()
+    } else {
+        sampler.skip();
+        0.5
+    };
+    (u, u_lobe)
 }
