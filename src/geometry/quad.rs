@@ -109,6 +109,7 @@ impl Quad {
     }
 
     /// Uniform point; density `1 / area`.
+    #[inline]
     pub fn sample_area(&self, u: DVec2) -> AreaSample {
         let point = self.corner + u.x * self.edge_u + u.y * self.edge_v;
         AreaSample {
