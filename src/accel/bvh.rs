@@ -41,10 +41,11 @@ pub const MAX_PRIMITIVES_PER_KIND: usize = 1 << COUNT_SHIFT;
 /// An unused child slot (its box is empty, so no ray enters it).
 const EMPTY_CHILD: u32 = u32::MAX;
 
-/// Entries of the fixed traversal stack. Each interior node visited leaves
-/// at most three siblings behind, so trees up to 21 levels deep (every
-/// scene of up to hundreds of millions of triangles in practice) traverse
-/// with it; deeper trees use a growable stack.
+/// Entries of the traversal stack kept on the call stack. Each interior
+/// node visited leaves at most three siblings behind, so trees up to 21
+/// levels deep (every scene of up to hundreds of millions of triangles in
+/// practice) never spill to the heap; deeper trees continue on a growable
+/// overflow.
 const FIXED_STACK: usize = 64;
 
 /// `1 + 2γ₃` in single precision (γₙ = nu/(1 − nu), u = 2⁻²⁴), rounded up
@@ -246,7 +247,9 @@ impl Bvh {
         self.traverse_sized::<false>(ray, t_max, visit);
     }
 
-    /// A fixed stack when the tree's depth allows, else a growable one.
+    /// One traversal loop for every tree: with a single copy of the loop
+    /// the leaf visitor has one call site, so the compiler inlines it (two
+    /// copies, one per stack type, left it an out-of-line call per leaf).
     #[inline(always)]
     fn traverse_sized<const NEAREST_FIRST: bool>(&self, ray: &Ray, t_max: &mut f64, visit: impl FnMut(Leaf, &mut f64) -> bool) {
         if self.nodes.is_empty() {
@@ -254,20 +257,14 @@ impl Bvh {
         }
         // Prepared here, in this frame, so the 240-byte record is never copied.
         let ray = &TraversalRay::new(ray);
-        let needed = 3 * self.depth;
-        if needed <= FIXED_STACK {
-            let mut stack = ArrayVec::<u64, FIXED_STACK>::new_const();
-            self.traverse_with::<NEAREST_FIRST>(&mut stack, ray, t_max, visit);
-        } else {
-            let mut stack = Vec::with_capacity(needed);
-            self.traverse_with::<NEAREST_FIRST>(&mut stack, ray, t_max, visit);
-        }
+        let mut stack = TraversalStack::new();
+        self.traverse_with::<NEAREST_FIRST>(&mut stack, ray, t_max, visit);
     }
 
     #[inline(always)]
     fn traverse_with<const NEAREST_FIRST: bool>(
         &self,
-        stack: &mut impl TraversalStack,
+        stack: &mut TraversalStack,
         ray: &TraversalRay,
         t_max: &mut f64,
         mut visit: impl FnMut(Leaf, &mut f64) -> bool,
@@ -362,34 +359,39 @@ fn unpack(entry: u64) -> (u32, f32) {
     (entry as u32, f32::from_bits((entry >> 32) as u32))
 }
 
-/// The traversal's stack of deferred children.
-trait TraversalStack {
-    fn push(&mut self, entry: u64);
-    fn pop(&mut self) -> Option<u64>;
+/// The traversal's stack of deferred children: a fixed-capacity array on
+/// the call stack (no allocation and, unlike a plain array, nothing to
+/// clear first), continued on the heap in the rare tree too deep for it.
+/// Entries leave in the reverse order they came whichever part holds them:
+/// the overflow fills only when the array is full, so it holds the newest.
+struct TraversalStack {
+    fixed: ArrayVec<u64, FIXED_STACK>,
+    overflow: Vec<u64>,
 }
 
-/// A fixed-capacity array on the call stack: no allocation and, unlike a
-/// plain array, nothing to clear first.
-impl<const N: usize> TraversalStack for ArrayVec<u64, N> {
+impl TraversalStack {
+    #[inline(always)]
+    fn new() -> Self {
+        Self {
+            fixed: ArrayVec::new_const(),
+            overflow: Vec::new(),
+        }
+    }
+
     #[inline(always)]
     fn push(&mut self, entry: u64) {
-        // The tree's depth bounds the entries (checked when the size is chosen).
-        ArrayVec::push(self, entry);
+        if let Err(full) = self.fixed.try_push(entry) {
+            self.overflow.push(full.element());
+        }
     }
 
     #[inline(always)]
     fn pop(&mut self) -> Option<u64> {
-        ArrayVec::pop(self)
-    }
-}
-
-impl TraversalStack for Vec<u64> {
-    fn push(&mut self, entry: u64) {
-        Vec::push(self, entry);
-    }
-
-    fn pop(&mut self) -> Option<u64> {
-        Vec::pop(self)
+        if self.overflow.is_empty() {
+            self.fixed.pop()
+        } else {
+            self.overflow.pop()
+        }
     }
 }
 

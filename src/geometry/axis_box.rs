@@ -25,6 +25,13 @@ impl AxisBox {
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
         let (axis, t) = self.solve(ray, t_max)?;
+        Some(self.surface_hit(ray, axis, t))
+    }
+
+    /// The hit record at distance `t` on a face normal to `axis` (as
+    /// [`AxisBox::solve`] found them).
+    #[inline]
+    pub fn surface_hit(&self, ray: &Ray, axis: usize, t: f64) -> SurfaceHit {
         let mut point = ray.at(t);
         // Snap the coordinate of the face that was hit onto the face plane.
         let center = self.bounds.centroid();
@@ -38,26 +45,26 @@ impl AxisBox {
         normal[axis] = if positive { 1.0 } else { -1.0 };
         let mut point_error = gamma(3) * (ray.origin.abs() + (t * ray.direction).abs());
         point_error[axis] = 0.0;
-        Some(SurfaceHit {
+        SurfaceHit {
             t,
             point,
             point_error,
             geometric_normal: normal,
             shading_normal: normal,
             uv: self.face_uv(point, axis),
-        })
+        }
     }
 
     /// Distance to the hit before `t_max`, without its record (shadow rays).
-    #[inline]
+    #[inline(always)]
     pub fn hit_distance(&self, ray: &Ray, t_max: f64) -> Option<f64> {
         self.solve(ray, t_max).map(|(_, t)| t)
     }
 
     /// The slab test (Kay & Kajiya 1986): the axis of the face hit and the
     /// distance to it; the exit face when the origin is inside.
-    #[inline]
-    fn solve(&self, ray: &Ray, t_max: f64) -> Option<(usize, f64)> {
+    #[inline(always)]
+    pub fn solve(&self, ray: &Ray, t_max: f64) -> Option<(usize, f64)> {
         let inverse = DVec3::ONE / ray.direction;
         let t0 = (self.bounds.min - ray.origin) * inverse;
         let t1 = (self.bounds.max - ray.origin) * inverse;

@@ -23,7 +23,7 @@ pub mod triangles;
 
 pub use axis_box::AxisBox;
 pub use clipped_sphere::ClippedSphere;
-pub use hit::{AreaSample, SurfaceHit};
+pub use hit::{AreaSample, ShapeHit, SurfaceHit};
 pub use mesh::Mesh;
 pub use quad::Quad;
 pub use revolution::Revolution;
@@ -91,7 +91,7 @@ impl Shape {
     }
 
     /// Distance to the nearest hit only: triangles skip their shading lookup.
-    #[inline]
+    #[inline(always)]
     pub fn hit_distance(&self, ray: &Ray, t_max: f64) -> Option<f64> {
         match self {
             Shape::Triangle(t) => t.intersect_raw(ray, t_max).map(|h| h.t),
@@ -99,6 +99,32 @@ impl Shape {
             Shape::AxisBox(b) => b.hit_distance(ray, t_max),
             Shape::Quad(q) => q.hit_distance(ray, t_max),
             Shape::Revolution(r) => r.intersect(ray, t_max).map(|h| h.t),
+        }
+    }
+
+    /// Nearest hit in `(0, t_max)` as the test found it, without its
+    /// record: for comparing candidates, then [`Shape::surface_hit`] for
+    /// the nearest.
+    #[inline(always)]
+    pub fn nearest_hit(&self, ray: &Ray, t_max: f64) -> Option<ShapeHit> {
+        match self {
+            Shape::Quad(q) => q.solve(ray, t_max).map(|(t, a, b)| ShapeHit::Quad { t, a, b }),
+            Shape::Sphere(s) => s.hit_distance(ray, t_max).map(ShapeHit::Sphere),
+            Shape::AxisBox(b) => b.solve(ray, t_max).map(|(axis, t)| ShapeHit::AxisBox { t, axis }),
+            Shape::Triangle(_) | Shape::Revolution(_) => self.hit_distance(ray, t_max).map(ShapeHit::Distance),
+        }
+    }
+
+    /// The record of a hit [`Shape::nearest_hit`] found on this shape,
+    /// the same as [`Shape::intersect`] would report for it: it is built
+    /// from the test's own results, or (for other shapes) by the same test
+    /// again with the bound just above the hit, which finds the same hit.
+    pub fn surface_hit(&self, ray: &Ray, hit: ShapeHit, meshes: &[Mesh]) -> Option<SurfaceHit> {
+        match (self, hit) {
+            (Shape::Quad(q), ShapeHit::Quad { t, a, b }) => Some(q.surface_hit(t, a, b)),
+            (Shape::Sphere(s), ShapeHit::Sphere(t)) => Some(s.hit_at(ray.at(t), t)),
+            (Shape::AxisBox(b), ShapeHit::AxisBox { t, axis }) => Some(b.surface_hit(ray, axis, t)),
+            _ => self.intersect(ray, hit.t().next_up(), meshes),
         }
     }
 
@@ -119,6 +145,8 @@ impl Shape {
     pub fn sample_from(&self, reference: DVec3, u: DVec2) -> Option<ShapeSample> {
         match self {
             Shape::Sphere(s) => s.sample_from(reference, u),
+            // The usual area light, without two more dispatches and calls.
+            Shape::Quad(q) => sampling::by_area(q.sample_area(u), q.area(), reference),
             _ => sampling::by_area(self.sample_area(u), self.area(), reference),
         }
     }

@@ -18,6 +18,8 @@ pub struct Quad {
     pub edge_v: DVec3,
     /// Unit normal `edge_u × edge_v`: the emitting side of a quad light.
     pub normal: DVec3,
+    /// `|edge_u × edge_v|`, kept because every light sample's density needs it.
+    area: f64,
 }
 
 impl Quad {
@@ -29,6 +31,7 @@ impl Quad {
             edge_u,
             edge_v,
             normal: edge_u.cross(edge_v).normalize(),
+            area: edge_u.cross(edge_v).length(),
         }
     }
 
@@ -44,36 +47,44 @@ impl Quad {
 
     /// Area `|edge_u × edge_v|`.
     pub fn area(&self) -> f64 {
-        self.edge_u.cross(self.edge_v).length()
+        self.area
     }
 
     /// Plane hit, then the parallelogram coordinates by Cramer's rule.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
         let (t, a, b) = self.solve(ray, t_max)?;
+        Some(self.surface_hit(t, a, b))
+    }
+
+    /// The hit record at distance `t` and coordinates `a`, `b` (as
+    /// [`Quad::solve`] found them).
+    #[inline]
+    pub fn surface_hit(&self, t: f64, a: f64, b: f64) -> SurfaceHit {
         let point = self.corner + a * self.edge_u + b * self.edge_v;
         let point_error = gamma(6) * (self.corner.abs() + (a * self.edge_u).abs() + (b * self.edge_v).abs());
-        Some(SurfaceHit {
+        SurfaceHit {
             t,
             point,
             point_error,
             geometric_normal: self.normal,
             shading_normal: self.normal,
             uv: DVec2::new(a, b),
-        })
+        }
     }
 
     /// Distance to the hit before `t_max`, without its record (shadow rays).
-    #[inline]
+    #[inline(always)]
     pub fn hit_distance(&self, ray: &Ray, t_max: f64) -> Option<f64> {
         self.solve(ray, t_max).map(|(t, _, _)| t)
     }
 
     /// The ray parameter and the hit's coordinates along the two edges
     /// (Möller & Trumbore 1997, with the second barycentric test made a
-    /// parallelogram's: both coordinates in [0, 1]).
-    #[inline]
-    fn solve(&self, ray: &Ray, t_max: f64) -> Option<(f64, f64, f64)> {
+    /// parallelogram's: both coordinates in [0, 1]). Inlined into the BVH's
+    /// leaf loop, where a call per candidate would cost as much as the test.
+    #[inline(always)]
+    pub fn solve(&self, ray: &Ray, t_max: f64) -> Option<(f64, f64, f64)> {
         let p = ray.direction.cross(self.edge_v);
         let det = self.edge_u.dot(p);
         if det == 0.0 {
@@ -98,6 +109,7 @@ impl Quad {
     }
 
     /// Uniform point; density `1 / area`.
+    #[inline]
     pub fn sample_area(&self, u: DVec2) -> AreaSample {
         let point = self.corner + u.x * self.edge_u + u.y * self.edge_v;
         AreaSample {

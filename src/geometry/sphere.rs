@@ -32,7 +32,7 @@ impl Sphere {
     }
 
     /// Nearest hit in `(0, t_max)`.
-    #[inline]
+    #[inline(always)]
     pub fn hit_distance(&self, ray: &Ray, t_max: f64) -> Option<f64> {
         let f = ray.origin - self.center;
         let b = f.dot(ray.direction);
@@ -67,7 +67,7 @@ impl Sphere {
     }
 
     /// The hit record for a point near the surface, reprojected onto it.
-    fn hit_at(&self, approximate_point: DVec3, t: f64) -> SurfaceHit {
+    pub fn hit_at(&self, approximate_point: DVec3, t: f64) -> SurfaceHit {
         let normal = (approximate_point - self.center).normalize();
         let (point, point_error) = self.point_with_normal(normal);
         SurfaceHit {

@@ -22,7 +22,7 @@ use crate::color::Color;
 use crate::geometry::clipped_sphere::clip_emitters;
 use crate::geometry::triangle::TriangleRay;
 use crate::geometry::triangles::{LeafHit, TriangleSource, Triangles, store_mesh_positions, stored_position};
-use crate::geometry::{Mesh, Shape, Sphere, SurfaceHit, Triangle};
+use crate::geometry::{Mesh, Shape, ShapeHit, Sphere, SurfaceHit, Triangle};
 use crate::light::{Emitter, EmitterSource, Light, Lights};
 use crate::material::{Material, Texture};
 use crate::math::{Aabb, Ray};
@@ -254,8 +254,9 @@ impl Scene {
     }
 
     /// Nearest hit in `(0, t_max)`. Triangles report only distance and
-    /// barycentrics during traversal; the hit record (normals, uv, error
-    /// bounds) is built once, for the final hit.
+    /// barycentrics during traversal, other shapes what their test found
+    /// ([`ShapeHit`]); the hit record (normals, uv, error bounds) is built
+    /// once, for the final hit, from those results.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<Intersection> {
         /// The nearest hit so far. Candidates are compared by distance
@@ -265,7 +266,7 @@ impl Scene {
         enum Nearest {
             Nothing,
             Triangle(LeafHit),
-            Shape(u32, f64),
+            Shape(u32, ShapeHit),
             Record(Intersection),
         }
         // The triangle test's per-ray constants, made when a triangle leaf is first reached.
@@ -287,9 +288,9 @@ impl Scene {
                             *t_max = hit.t;
                             nearest = Nearest::Record(Intersection { hit, primitive: index });
                         }
-                    } else if let Some(t) = shape.hit_distance(ray, *t_max) {
-                        *t_max = t;
-                        nearest = Nearest::Shape(index, t);
+                    } else if let Some(hit) = shape.nearest_hit(ray, *t_max) {
+                        *t_max = hit.t();
+                        nearest = Nearest::Shape(index, hit);
                     }
                 }
             }
@@ -305,10 +306,8 @@ impl Scene {
                     primitive: self.shapes.len() as u32 + found.index,
                 })
             }
-            Nearest::Shape(index, t) => {
-                // The same arithmetic as `hit_distance`, so with the bound
-                // just above `t` it finds the same hit.
-                let hit = self.shapes[index as usize].shape.intersect(ray, t.next_up(), &self.meshes)?;
+            Nearest::Shape(index, found) => {
+                let hit = self.shapes[index as usize].shape.surface_hit(ray, found, &self.meshes)?;
                 Some(Intersection { hit, primitive: index })
             }
             Nearest::Record(found) => Some(found),

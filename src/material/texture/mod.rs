@@ -46,9 +46,20 @@ pub enum Texture {
 }
 
 impl Texture {
-    /// The reflectance at `at`.
-    #[inline]
+    /// The reflectance at `at`. A constant is read where it is needed; the
+    /// patterns are a call away (the whole `match` inlined into every BSDF
+    /// was too large to inline, which cost a call per constant too).
+    #[inline(always)]
     pub fn evaluate(&self, at: &ShadingPoint) -> Color {
+        match self {
+            Texture::Constant(c) => *c,
+            pattern => pattern.evaluate_pattern(at),
+        }
+    }
+
+    /// [`Texture::evaluate`] for the textures that vary.
+    #[inline(never)]
+    fn evaluate_pattern(&self, at: &ShadingPoint) -> Color {
         match self {
             Texture::Constant(c) => *c,
             Texture::Image { image, mapping, wrap } => image.bilinear(mapping.map(at), *wrap),
