@@ -1,32 +1,43 @@
-//! RGB → spectrum: Smits 1999, "An RGB-to-Spectrum Conversion for
-//! Reflectances" (Journal of Graphics Tools 4(4)).
+//! RGB → spectrum: Smits' decomposition (Smits 1999, "An RGB-to-Spectrum
+//! Conversion for Reflectances", Journal of Graphics Tools 4(4)) with basis
+//! spectra fitted so that spectra multiply as RGB does.
 //!
 //! Smits writes an RGB colour as a non-negative combination of a white, one
 //! secondary (cyan, magenta or yellow) and one primary (red, green or blue)
-//! basis spectrum, chosen by the order of the channels. Why Smits rather
+//! basis spectrum, chosen by the order of the channels. Why this rather
 //! than Jakob & Hanika 2019's sigmoid polynomials:
 //! - the map is *linear* within each channel ordering and adds white
 //!   exactly (S(a·c + b·white) = a·S(c) + b for a, b ≥ 0), so uplifting a
 //!   BSDF value (albedo/π, a Schlick-tinted microfacet term, a tinted
 //!   Fresnel weight) gives exactly the BSDF of the uplifted albedo: the
 //!   materials keep returning RGB and the path tracer uplifts their values;
-//! - it needs seven small tables rather than a 3 × 64³ coefficient table
-//!   fitted by an optimiser;
-//! - for reflectances in [0, 1] the spectra stay in [0, 1] up to the small
-//!   correction below, and one set of tables serves emission too, because
-//!   the film's white is the constant spectrum (see [`super::sensor`]).
-//!   Jakob & Hanika fit spectra that are smoother and bounded by
-//!   construction; Smits' are only piecewise smooth, which nothing here
-//!   needs.
+//! - for reflectances in [0, 1] the spectra stay in [0, 1], and one set of
+//!   tables serves emission too, because the film's white is the constant
+//!   spectrum (see [`super::sensor`]).
 //!
-//! Smits' basis spectra (his table 1, ten bins over 380–720 nm) were fitted
-//! to other matching functions and a different white; here each is linearly
-//! interpolated between bin centres, extended flat to 360–830 nm, and then
-//! corrected by adding the combination of x̄, ȳ, z̄ that makes its RGB
-//! *exactly* the target (1 for its channels, 0 for the others) under this
-//! film's [`Sensor`]. Since the map is linear per ordering, every RGB then
-//! round-trips exactly (to the f64 rounding of the grid integrals); the
-//! test below prints the error before and after the correction.
+//! **Which basis.** Linearity also says what decides how far a spectral
+//! render strays from an RGB one. The product of two uplifted colours is a
+//! sum of products of basis spectra, so the RGB of *every* such product
+//! equals the product of the RGBs exactly when the basis has RGB's
+//! multiplication table: RGB(Sᵢ·Sⱼ) = tᵢ∘tⱼ, with tᵢ the RGB basis i
+//! stands for (red (1, 0, 0), cyan (0, 1, 1), …). Spectra in [0, 1] cannot
+//! meet it exactly: RGB(S²) = RGB(S) forces S to be 0 or 1 everywhere,
+//! and since the matching functions overlap no such box has an RGB of
+//! exactly (1, 0, 0). Smits' table, fitted for other goals, misses it by
+//! 0.062 RMS over the 21 pairs (after the round-trip correction below): a
+//! warm light on the Cornell box's red wall then loses a third of its blue,
+//! and the image's blue mean 3.5%. So the basis here is fitted, from
+//! Smits' table as a start, to minimise that defect subject to an exact
+//! round trip and to staying in [0, 1] (`benches/spectral/fit_uplift_basis.py`,
+//! exact integrals, tables in [`fitted_basis`]); it reaches 0.013. The
+//! spectra come out as near-boxes with a few narrow features where the
+//! round trip needs them.
+//!
+//! Each table is printed to six digits; adding the combination of x̄, ȳ, z̄
+//! that makes its RGB *exactly* the target under this film's [`Sensor`]
+//! removes that rounding, so every RGB round-trips exactly (to the f64
+//! rounding of the grid integrals). The same correction applied to Smits'
+//! own table ([`Basis::smits`]) is what the tests compare against.
 
 use super::cie::{GRID_POINTS, GRID_START, GRID_STEP, matching_table};
 use super::sensor::Sensor;
@@ -65,7 +76,7 @@ const RED: usize = 3;
 const GREEN: usize = 4;
 const BLUE: usize = 5;
 
-/// The six coloured basis spectra on the spectral grid, corrected to this film.
+/// Six coloured basis spectra on the spectral grid, corrected to this film.
 #[derive(Clone, Debug)]
 pub struct Basis {
     /// Cyan, magenta, yellow, red, green, blue.
@@ -73,12 +84,20 @@ pub struct Basis {
 }
 
 impl Basis {
-    /// The corrected basis, built on first use.
+    /// The fitted basis the renderer uses, built on first use.
     pub fn get() -> &'static Basis {
         static BASIS: OnceLock<Basis> = OnceLock::new();
         BASIS.get_or_init(|| Basis {
-            tables: std::array::from_fn(|k| corrected(&smits_on_grid(k), TARGETS[k])),
+            tables: std::array::from_fn(|k| corrected(&fitted_basis::FITTED_BASIS[k], TARGETS[k])),
         })
+    }
+
+    /// Smits' own table, corrected to round-trip on this film in the same
+    /// way: the starting point of the fit, kept to measure what it gained.
+    pub fn smits() -> Basis {
+        Basis {
+            tables: std::array::from_fn(|k| corrected(&smits_on_grid(k), TARGETS[k])),
+        }
     }
 }
 
@@ -146,11 +165,13 @@ pub fn spectrum_of_rgb(rgb: Color, wavelengths: &SampledWavelengths) -> SampledS
 }
 
 /// The same spectrum as a whole grid table, from the given basis tables
-/// (the corrected [`Basis`], or Smits' own to measure what the correction does).
+/// (a corrected [`Basis`], or Smits' raw table to measure what the correction does).
 pub fn spectrum_table_of_rgb(rgb: Color, tables: &[[f64; GRID_POINTS]; 6]) -> [f64; GRID_POINTS] {
     let (white, pairs) = smits_weights(rgb);
     std::array::from_fn(|i| white + pairs.iter().map(|&(k, w)| w * tables[k][i]).sum::<f64>())
 }
+
+mod fitted_basis;
 
 #[cfg(test)]
 mod tests;
