@@ -5,7 +5,7 @@
 //! - [`cie`]: the CIE 1931 colour-matching functions on a 5 nm grid;
 //! - [`sensor`]: the film's spectrum → XYZ → linear sRGB conversion;
 //! - [`dispersion`]: indices of refraction that vary with wavelength;
-//! - [`uplift`]: RGB reflectances and emissions as smooth spectra (Smits 1999);
+//! - [`uplift`]: RGB reflectances and emissions as spectra (Smits' 1999 decomposition over basis spectra fitted to multiply as RGB does);
 //! - [`illuminant`], [`blackbody`]: emission spectra of their own (CIE D65
 //!   and A, Planck's law), and [`emission`]: what a light emits, as RGB or
 //!   at sampled wavelengths;

@@ -25,11 +25,12 @@
 //! and since the matching functions overlap no such box has an RGB of
 //! exactly (1, 0, 0). Smits' table, fitted for other goals, misses it by
 //! 0.062 RMS over the 21 pairs (after the round-trip correction below): a
-//! warm light on the Cornell box's red wall then loses a third of its blue,
-//! and the image's blue mean 3.5%. So the basis here is fitted, from
-//! Smits' table as a start, to minimise that defect subject to an exact
-//! round trip and to staying in [0, 1] (`benches/spectral/fit_uplift_basis.py`,
-//! exact integrals, tables in [`fitted_basis`]); it reaches 0.013. The
+//! warm light on the Cornell box's red wall then keeps 5% of its RGB
+//! product's blue, and the image's blue mean loses 3.5%. So the basis here
+//! is fitted, from Smits' table as a start, to minimise that defect subject
+//! to an exact round trip and to staying in [0, 1]
+//! (`benches/spectral/fit_uplift_basis.py`, exact integrals, tables in
+//! [`fitted_basis`]); it reaches 0.013. The
 //! spectra come out as near-boxes with a few narrow features where the
 //! round trip needs them.
 //!
