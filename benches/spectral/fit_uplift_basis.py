@@ -41,16 +41,6 @@ NAMES = ["cyan", "magenta", "yellow", "red", "green", "blue"]
 TARGETS = np.array([[0, 1, 1], [1, 0, 1], [1, 1, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
 # IEC 61966-2-1 XYZ -> linear sRGB, as src/spectrum/sensor.rs.
 XYZ_TO_SRGB = np.array([[3.2406, -1.5372, -0.4986], [-0.9689, 1.8758, 0.0415], [0.0557, -0.2040, 1.0570]])
-# Smits 1999, table 1 (cyan, magenta, yellow, red, green, blue at ten bin
-# centres over 380-720 nm), as in src/spectrum/uplift.rs.
-SMITS_1999 = np.array([
-    [0.9710, 0.9426, 1.0007, 1.0007, 1.0007, 1.0007, 0.1564, 0.0000, 0.0000, 0.0000],
-    [1.0000, 1.0000, 0.9685, 0.2229, 0.0000, 0.0458, 0.8369, 1.0000, 1.0000, 0.9959],
-    [0.0001, 0.0000, 0.1088, 0.6651, 1.0000, 1.0000, 0.9996, 0.9586, 0.9685, 0.9840],
-    [0.1012, 0.0515, 0.0000, 0.0000, 0.0000, 0.0000, 0.8325, 1.0149, 1.0149, 1.0149],
-    [0.0000, 0.0000, 0.0273, 0.7937, 1.0000, 0.9418, 0.1719, 0.0000, 0.0000, 0.0025],
-    [1.0000, 1.0000, 0.8916, 0.3323, 0.0000, 0.0000, 0.0003, 0.0369, 0.0483, 0.0496],
-])
 
 
 def read_cie_table():
@@ -65,7 +55,20 @@ def read_cie_table():
     return table
 
 
+def read_smits_table():
+    """Smits 1999, table 1 (cyan, magenta, yellow, red, green, blue at ten bin
+    centres over 380-720 nm), exactly as src/spectrum/uplift.rs has it."""
+    text = (ROOT / "src/spectrum/uplift.rs").read_text()
+    block = text[text.index("= [", text.index("const SMITS_1999")):]
+    block = block[: block.index("];")]
+    rows = [re.findall(r"[0-9.]+", row) for row in re.findall(r"\[([^\]]+)\]", block)]
+    table = np.array(rows, float)
+    assert table.shape == (6, 10), table.shape
+    return table
+
+
 CMF = read_cie_table()
+SMITS_1999 = read_smits_table()
 GRID = 360.0 + 5.0 * np.arange(95)
 # Simpson nodes: the grid points and the interval midpoints; a grid table is
 # read there by linear interpolation, which is what the renderer does.
