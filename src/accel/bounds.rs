@@ -89,34 +89,41 @@ fn pick_max(a: f32, b: f32) -> f32 {
 
 /// The largest `f32` not above `x` and the smallest not below it (equal
 /// when `x` is an `f32`), from one conversion and the neighbours' bit
-/// patterns, without branches (ray origins are finite and within `f32`'s
-/// range, which the scene's coordinate limit ensures).
+/// patterns (ray origins are finite and within `f32`'s range, which the
+/// scene's coordinate limit ensures).
+///
+/// Whether the conversion rounded up or down is a coin toss per ray, which
+/// a branch would mispredict half the time, so it is read from the sign
+/// bit of the difference (a rounded difference has the sign of the exact
+/// one) and applied as a mask. One ulp towards +∞ is +1 on the bits of a
+/// positive number and −1 on those of a negative one. Zero needs no
+/// special case: the conversion keeps the sign, so a negative `x` rounds
+/// up only to −0 (whose −1 step gives the smallest negative subnormal)
+/// and a positive one down only to +0 (whose +1 step gives the smallest
+/// positive one).
 #[inline(always)]
 pub fn bracket(x: f64) -> (f32, f32) {
     let rounded = x as f32;
     let back = f64::from(rounded);
     let bits = rounded.to_bits();
-    let negative = bits >> 31 != 0;
-    let zero = bits << 1 == 0;
-    // One ulp towards +∞ and towards −∞ (a zero's neighbours are the
-    // smallest subnormals).
-    let above = if zero {
-        1
-    } else if negative {
-        bits - 1
-    } else {
-        bits + 1
-    };
-    let below = if zero {
-        0x8000_0001
-    } else if negative {
-        bits + 1
-    } else {
-        bits - 1
-    };
-    let down = if back > x { f32::from_bits(below) } else { rounded };
-    let up = if back < x { f32::from_bits(above) } else { rounded };
-    (down, up)
+    let step = sign_mask32(bits) | 1;
+    let rounded_up = sign_mask64(x - back);
+    let rounded_down = sign_mask64(back - x);
+    let down = bits.wrapping_sub(step & rounded_up);
+    let up = bits.wrapping_add(step & rounded_down);
+    (f32::from_bits(down), f32::from_bits(up))
+}
+
+/// All ones when the sign bit of `bits` is set, else zero.
+#[inline(always)]
+pub fn sign_mask32(bits: u32) -> u32 {
+    ((bits as i32) >> 31) as u32
+}
+
+/// All ones when `x` is negative (its sign bit is set), else zero.
+#[inline(always)]
+fn sign_mask64(x: f64) -> u32 {
+    ((x.to_bits() as i64) >> 63) as u32
 }
 
 /// The largest `f32` not above `x`.

@@ -16,7 +16,7 @@
 //! how to hit them, is the caller's closure. Leaves hold primitives of one
 //! kind (triangles, or other shapes), numbered within that kind.
 
-use super::bounds::{Bounds32, round_up};
+use super::bounds::{Bounds32, round_up, sign_mask32};
 use super::build::{self, BinaryContent, BinaryNode, Box4, BuildItem, MAX_LEAF_SIZE};
 use super::collapse::Collapse;
 use crate::math::{Aabb, Ray};
@@ -445,25 +445,26 @@ impl TraversalRay {
     #[inline(always)]
     pub fn new(ray: &Ray) -> Self {
         let reciprocal: [f32; 3] = std::array::from_fn(|axis| (1.0 / ray.direction[axis]) as f32);
-        let bracket: [(f32, f32); 3] = std::array::from_fn(|axis| super::bounds::bracket(ray.origin[axis]));
-        let enters_through_minimum: [bool; 3] = std::array::from_fn(|axis| reciprocal[axis] >= 0.0);
-        TraversalRay {
+        // All ones for the axes the ray crosses towards −∞, entering through
+        // the maximum: a mask, not a branch, as the signs are unpredictable.
+        let towards_minus = reciprocal.map(|r| sign_mask32(r.to_bits()));
+        let origins: [(f32, f32); 3] = std::array::from_fn(|axis| {
             // Entering through the minimum, (min − o)·r is smallest for the
             // largest o; through the maximum (r < 0), for the smallest.
-            entry_origin: std::array::from_fn(|axis| {
-                let (down, up) = bracket[axis];
-                f32x4::splat(if enters_through_minimum[axis] { up } else { down })
-            }),
-            exit_origin: std::array::from_fn(|axis| {
-                let (down, up) = bracket[axis];
-                f32x4::splat(if enters_through_minimum[axis] { down } else { up })
-            }),
-            reciprocal: std::array::from_fn(|axis| f32x4::splat(reciprocal[axis])),
+            let (down, up) = super::bounds::bracket(ray.origin[axis]);
+            let (down, up) = (down.to_bits(), up.to_bits());
+            let swap = (down ^ up) & towards_minus[axis];
+            (f32::from_bits(up ^ swap), f32::from_bits(down ^ swap))
+        });
+        TraversalRay {
+            entry_origin: origins.map(|(entry, _)| f32x4::splat(entry)),
+            exit_origin: origins.map(|(_, exit)| f32x4::splat(exit)),
+            reciprocal: reciprocal.map(f32x4::splat),
             // Four roundings in all ((b − o), r, r·scale, the product) stay
             // within 1 − 4u of exact, which the 1 + 2⁻²¹ scale covers.
-            exit_reciprocal: std::array::from_fn(|axis| f32x4::splat(reciprocal[axis] * FAR_SCALE)),
-            entry_plane: std::array::from_fn(|axis| 2 * axis + usize::from(!enters_through_minimum[axis])),
-            exit_plane: std::array::from_fn(|axis| 2 * axis + usize::from(enters_through_minimum[axis])),
+            exit_reciprocal: reciprocal.map(|r| f32x4::splat(r * FAR_SCALE)),
+            entry_plane: std::array::from_fn(|axis| 2 * axis + (towards_minus[axis] & 1) as usize),
+            exit_plane: std::array::from_fn(|axis| 2 * axis + 1 - (towards_minus[axis] & 1) as usize),
         }
     }
 

@@ -79,19 +79,17 @@ impl Candidates {
 }
 
 /// Tests the triangles of the lanes in `active` (bit i for lane i), whose
-/// vertex coordinates are `vertices` (x, y, z of vertex 0, then of 1 and 2,
-/// each over the four lanes), for hits in `(0, t_max)`; `None` when no
+/// vertices are `vertices` (each over the four lanes, its coordinates
+/// already in the ray's permuted axis order), for hits in `(0, t_max)`; `None` when no
 /// lane is hit (so `Some` answers an any-hit query).
 #[inline(always)]
-pub fn intersect(ray: &TriangleRay, vertices: &[Lanes; 9], active: u32, t_max: f64) -> Option<Candidates> {
-    let [kx, ky, kz] = ray.axes;
+pub fn intersect(ray: &TriangleRay, vertices: &[[Lanes; 3]; 3], active: u32, t_max: f64) -> Option<Candidates> {
     let origin = ray.origin.map(Lanes::splat);
     let (shear_x, shear_y) = (Lanes::splat(ray.shear_x), Lanes::splat(ray.shear_y));
     // Translate to the ray origin, permute, shear so the ray is +z.
     let transform = |i: usize| {
-        let x = vertices[3 * i + kx] - origin[0];
-        let y = vertices[3 * i + ky] - origin[1];
-        let z = vertices[3 * i + kz] - origin[2];
+        let [x, y, z] = vertices[i];
+        let (x, y, z) = (x - origin[0], y - origin[1], z - origin[2]);
         [x + shear_x * z, y + shear_y * z, z]
     };
     let p = [transform(0), transform(1), transform(2)];

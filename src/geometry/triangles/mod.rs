@@ -20,8 +20,9 @@
 //! contiguous bytes (at most 144: two or three cache lines), and reading
 //! four floats from `9f + k·n` gives coordinate k of all its triangles in
 //! four lanes ([`lanes`] tests them together); lanes past n read the next
-//! coordinates (or, at the end, three floats of padding) and are masked
-//! off. Per triangle there is also one 32-bit word with its mesh (for the
+//! coordinates (or, at the end, padding) and are masked off. The test
+//! takes a leaf as one fixed 36-float window from `9f`, so its nine loads
+//! need no bounds checks of their own. Per triangle there is also one 32-bit word with its mesh (for the
 //! anchor) and its lane and leaf size (to find its offsets again), and the
 //! cold face and material: 48 bytes per triangle in all.
 
@@ -50,8 +51,15 @@ const MESH_BITS: u32 = 28;
 const MESH_MASK: u32 = (1 << MESH_BITS) - 1;
 /// Most meshes the triangles can refer to.
 pub const MAX_MESHES: usize = 1 << MESH_BITS;
-/// Lanes read past a leaf's end: the padding after the last one.
-const PADDING: usize = 3;
+/// Floats of a full leaf (four triangles, nine coordinates each). The leaf
+/// test reads this many from a leaf's start whatever its size, so the
+/// offsets end with enough padding for the last leaf's window.
+const LEAF_FLOATS: usize = 36;
+/// Zeros after the last offset: a one-triangle leaf at the end reads 27
+/// floats past its nine.
+const OFFSET_PADDING: usize = LEAF_FLOATS - 9;
+/// Zeros after the last placement word: a leaf's four lanes read four words.
+const PLACEMENT_PADDING: usize = 3;
 
 /// What only the final hit needs.
 #[derive(Clone, Copy, Debug)]
@@ -64,9 +72,9 @@ struct ColdData {
 #[derive(Clone, Debug, Default)]
 pub struct Triangles {
     /// Vertex offsets from the mesh anchors, leaf by leaf as
-    /// structure-of-arrays (see the module doc), then [`PADDING`] zeros.
+    /// structure-of-arrays (see the module doc), then [`OFFSET_PADDING`] zeros.
     offsets: Vec<f32>,
-    /// Per triangle: mesh, lane and leaf size (see [`MESH_BITS`]), then [`PADDING`] zeros.
+    /// Per triangle: mesh, lane and leaf size (see [`MESH_BITS`]), then [`PLACEMENT_PADDING`] zeros.
     placement: Vec<u32>,
     cold: Vec<ColdData>,
     /// Per mesh: the point offsets are measured from.
@@ -94,8 +102,8 @@ impl Triangles {
     /// stored as mesh 0.
     pub fn new(triangles: &[(Triangle, u32)], order: &[u32], leaves: &[Leaf], anchors: Vec<DVec3>) -> Self {
         let count = order.len();
-        let mut offsets = vec![0.0f32; 9 * count + PADDING];
-        let mut placement = vec![0u32; count + PADDING];
+        let mut offsets = vec![0.0f32; 9 * count + OFFSET_PADDING];
+        let mut placement = vec![0u32; count + PLACEMENT_PADDING];
         let mut cold = vec![ColdData { face: 0, material: 0 }; count];
         let anchor_of = |mesh: u32| anchors.get(mesh as usize).copied().unwrap_or(DVec3::ZERO);
         for leaf in leaves {
@@ -185,24 +193,33 @@ impl Triangles {
         }
     }
 
-    /// The stored vertex coordinates of the leaf's triangles, one per lane
-    /// (anchor + offset, in `f64`, exactly as [`Triangles::get`] makes them).
+    /// The stored vertices of the leaf's triangles, one triangle per lane,
+    /// with their axes in the ray's permuted order (`vertices[i][j]` is
+    /// vertex i's coordinate on axis `ray.axes[j]`), as anchor + offset in
+    /// `f64`, exactly as [`Triangles::get`] makes them. The leaf's block is
+    /// read as one window, so each coordinate is one four-float load.
     #[inline(always)]
-    fn leaf_vertices(&self, first: u32, count: u32) -> [Lanes; 9] {
+    fn leaf_vertices(&self, ray: &TriangleRay, first: u32, count: u32) -> Option<[[Lanes; 3]; 3]> {
         let (first, n) = (first as usize, count as usize);
+        let block: &[f32; LEAF_FLOATS] = self.offsets.get(9 * first..)?.first_chunk()?;
         let anchor: [Lanes; 3] = match self.shared_anchor {
-            Some(anchor) => anchor.to_array().map(Lanes::splat),
+            Some(anchor) => ray.axes.map(|axis| Lanes::splat(anchor[axis])),
             None => {
                 let words: [u32; 4] = std::array::from_fn(|lane| self.placement[first + lane]);
                 let anchors = words.map(|word| self.anchor(word & MESH_MASK));
-                std::array::from_fn(|axis| Lanes::new(anchors.map(|a| a[axis])))
+                ray.axes.map(|axis| Lanes::new(anchors.map(|a| a[axis])))
             }
         };
-        std::array::from_fn(|k| {
-            let start = 9 * first + k * n;
-            let offsets: [f32; 4] = std::array::from_fn(|lane| self.offsets[start + lane]);
-            anchor[k % 3] + Lanes::new(offsets.map(f64::from))
-        })
+        // Coordinate k of the four lanes starts at k·n; k ≤ 8 and n ≤ 4, so
+        // the clamp changes nothing and spares a bounds check per load.
+        let coordinate = |k: usize| {
+            let start = (k * n).min(LEAF_FLOATS - 4);
+            let four: [f32; 4] = std::array::from_fn(|lane| block[start..start + 4][lane]);
+            Lanes::new(four.map(f64::from))
+        };
+        Some(std::array::from_fn(|vertex| {
+            std::array::from_fn(|j| anchor[j] + coordinate(3 * vertex + ray.axes[j]))
+        }))
     }
 
     /// The nearest hit in `(0, t_max)` among triangles `first .. first + count`
@@ -211,7 +228,7 @@ impl Triangles {
     /// before it.
     #[inline(always)]
     pub fn intersect_leaf(&self, ray: &TriangleRay, first: u32, count: u32, t_max: f64) -> Option<LeafHit> {
-        let vertices = self.leaf_vertices(first, count);
+        let vertices = self.leaf_vertices(ray, first, count)?;
         let candidates = lanes::intersect(ray, &vertices, (1 << count) - 1, t_max)?;
         let (lane, hit) = candidates.nearest(t_max)?;
         Some(LeafHit {
@@ -223,8 +240,9 @@ impl Triangles {
     /// Whether any of triangles `first .. first + count` (a leaf) is hit in `(0, t_max)`.
     #[inline(always)]
     pub fn occludes_leaf(&self, ray: &TriangleRay, first: u32, count: u32, t_max: f64) -> bool {
-        let vertices = self.leaf_vertices(first, count);
-        lanes::intersect(ray, &vertices, (1 << count) - 1, t_max).is_some()
+        self.leaf_vertices(ray, first, count)
+            .and_then(|vertices| lanes::intersect(ray, &vertices, (1 << count) - 1, t_max))
+            .is_some()
     }
 }
 /// The point a mesh's offsets are measured from: the centre of its bounds.
