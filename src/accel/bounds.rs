@@ -127,19 +127,29 @@ fn sign_mask64(x: f64) -> u32 {
 }
 
 /// The largest `f32` not above `x`.
+#[inline]
 pub fn round_down(x: f64) -> f32 {
     let rounded = x as f32;
-    if f64::from(rounded) > x {
-        rounded.next_down()
-    } else {
-        rounded
-    }
+    let bits = rounded.to_bits();
+    let step = sign_mask32(bits) | 1;
+    f32::from_bits(bits.wrapping_sub(step & all_ones_if(f64::from(rounded) > x)))
 }
 
-/// The smallest `f32` not below `x`.
+/// The smallest `f32` not below `x`. Like [`bracket`], without a branch on
+/// which way the conversion rounded (the traversal rounds every new
+/// nearest-hit distance, and which way it goes is a coin toss).
+#[inline]
 pub fn round_up(x: f64) -> f32 {
     let rounded = x as f32;
-    if f64::from(rounded) < x { rounded.next_up() } else { rounded }
+    let bits = rounded.to_bits();
+    let step = sign_mask32(bits) | 1;
+    f32::from_bits(bits.wrapping_add(step & all_ones_if(f64::from(rounded) < x)))
+}
+
+/// All ones when `condition` holds, else zero.
+#[inline(always)]
+fn all_ones_if(condition: bool) -> u32 {
+    u32::from(condition).wrapping_neg()
 }
 
 #[cfg(test)]
