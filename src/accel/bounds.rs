@@ -88,62 +88,48 @@ fn pick_max(a: f32, b: f32) -> f32 {
 }
 
 /// The largest `f32` not above `x` and the smallest not below it (equal
-/// when `x` is an `f32`), from one conversion and the neighbours' bit
-/// patterns (ray origins are finite and within `f32`'s range, which the
-/// scene's coordinate limit ensures).
-///
-/// Whether the conversion rounded up or down is a coin toss per ray, which
-/// a branch would mispredict half the time, so it is read from the sign
-/// bit of the difference (a rounded difference has the sign of the exact
-/// one) and applied as a mask. One ulp towards +∞ is +1 on the bits of a
-/// positive number and −1 on those of a negative one. Zero needs no
-/// special case: the conversion keeps the sign, so a negative `x` rounds
-/// up only to −0 (whose −1 step gives the smallest negative subnormal)
-/// and a positive one down only to +0 (whose +1 step gives the smallest
-/// positive one).
+/// when `x` is an `f32`): [`round_down`] and [`round_up`], which share
+/// their conversion once inlined.
 #[inline(always)]
 pub fn bracket(x: f64) -> (f32, f32) {
-    let rounded = x as f32;
-    let back = f64::from(rounded);
-    let bits = rounded.to_bits();
-    let step = sign_mask32(bits) | 1;
-    let rounded_up = sign_mask64(x - back);
-    let rounded_down = sign_mask64(back - x);
-    let down = bits.wrapping_sub(step & rounded_up);
-    let up = bits.wrapping_add(step & rounded_down);
-    (f32::from_bits(down), f32::from_bits(up))
+    (round_down(x), round_up(x))
+}
+
+/// The largest `f32` not above `x`.
+#[inline(always)]
+pub fn round_down(x: f64) -> f32 {
+    let (bits, step) = nearest_and_step(x);
+    f32::from_bits(bits.wrapping_sub(step & all_ones_if(f64::from(f32::from_bits(bits)) > x)))
+}
+
+/// The smallest `f32` not below `x`.
+#[inline(always)]
+pub fn round_up(x: f64) -> f32 {
+    let (bits, step) = nearest_and_step(x);
+    f32::from_bits(bits.wrapping_add(step & all_ones_if(f64::from(f32::from_bits(bits)) < x)))
+}
+
+/// The bits of `x` rounded to the nearest `f32`, and the change to them
+/// that moves one ulp towards +∞: +1 for a positive number, −1 (all ones)
+/// for a negative one.
+///
+/// The roundings apply that step under a mask rather than behind a
+/// branch: which way the conversion rounded is a coin toss per ray (for
+/// ray origins and every new nearest-hit distance), so a branch would be
+/// mispredicted half the time. Zero needs no special case: the
+/// conversion keeps the sign, so a negative `x` rounds up only to −0
+/// (whose −1 step gives the smallest negative subnormal) and a positive
+/// one down only to +0 (whose +1 step gives the smallest positive one).
+#[inline(always)]
+fn nearest_and_step(x: f64) -> (u32, u32) {
+    let bits = (x as f32).to_bits();
+    (bits, sign_mask32(bits) | 1)
 }
 
 /// All ones when the sign bit of `bits` is set, else zero.
 #[inline(always)]
 pub fn sign_mask32(bits: u32) -> u32 {
     ((bits as i32) >> 31) as u32
-}
-
-/// All ones when `x` is negative (its sign bit is set), else zero.
-#[inline(always)]
-fn sign_mask64(x: f64) -> u32 {
-    ((x.to_bits() as i64) >> 63) as u32
-}
-
-/// The largest `f32` not above `x`.
-#[inline]
-pub fn round_down(x: f64) -> f32 {
-    let rounded = x as f32;
-    let bits = rounded.to_bits();
-    let step = sign_mask32(bits) | 1;
-    f32::from_bits(bits.wrapping_sub(step & all_ones_if(f64::from(rounded) > x)))
-}
-
-/// The smallest `f32` not below `x`. Like [`bracket`], without a branch on
-/// which way the conversion rounded (the traversal rounds every new
-/// nearest-hit distance, and which way it goes is a coin toss).
-#[inline]
-pub fn round_up(x: f64) -> f32 {
-    let rounded = x as f32;
-    let bits = rounded.to_bits();
-    let step = sign_mask32(bits) | 1;
-    f32::from_bits(bits.wrapping_add(step & all_ones_if(f64::from(rounded) < x)))
 }
 
 /// All ones when `condition` holds, else zero.
