@@ -80,8 +80,8 @@ impl Candidates {
 
 /// Tests the triangles of the lanes in `active` (bit i for lane i), whose
 /// vertices are `vertices` (each over the four lanes, its coordinates
-/// already in the ray's permuted axis order), for hits in `(0, t_max)`; `None` when no
-/// lane is hit (so `Some` answers an any-hit query).
+/// already in the ray's permuted axis order), for hits in `(0, t_max)`;
+/// `None` when no lane is hit (so `Some` answers an any-hit query).
 #[inline(always)]
 pub fn intersect(ray: &TriangleRay, vertices: &[[Lanes; 3]; 3], active: u32, t_max: f64) -> Option<Candidates> {
     let origin = ray.origin.map(Lanes::splat);

@@ -22,9 +22,10 @@
 //! four lanes ([`lanes`] tests them together); lanes past n read the next
 //! coordinates (or, at the end, padding) and are masked off. The test
 //! takes a leaf as one fixed 36-float window from `9f`, so its nine loads
-//! need no bounds checks of their own. Per triangle there is also one 32-bit word with its mesh (for the
-//! anchor) and its lane and leaf size (to find its offsets again), and the
-//! cold face and material: 48 bytes per triangle in all.
+//! need no bounds checks of their own. Per triangle there is also one
+//! 32-bit word with its mesh (for the anchor) and its lane and leaf size
+//! (to find its offsets again), and the cold face and material: 48 bytes
+//! per triangle in all.
 
 mod lanes;
 
