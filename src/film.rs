@@ -45,25 +45,45 @@ pub fn accepts(sample: Color) -> bool {
     sample.is_finite() && sample.abs().max_element() < MAX_SAMPLE_VALUE
 }
 
-/// `value` (|value| < 2⁶³) in fixed point with 64 fractional bits, rounded
-/// toward zero. The whole part is truncated in an integer register and the
-/// fractional part (always exact in f64) scaled by a power of two, so the
-/// conversion is a few instructions rather than a 128-bit library call.
+/// `value` (finite, |value| < 2⁵³; accepted samples are below 2³¹) in fixed
+/// point with 64 fractional bits, rounded toward zero: trunc(value · 2⁶⁴).
 #[inline]
 fn fixed_64(value: f64) -> i128 {
-    let magnitude = value.abs();
-    let whole = magnitude as u64;
-    let fraction = ((magnitude - whole as f64) * TWO_POW_64) as u64;
-    let fixed = (((whole as u128) << 64) | fraction as u128) as i128;
-    if value < 0.0 { -fixed } else { fixed }
+    let magnitude = truncated_fixed_point(value, COLOR_FRACTION_BITS) as i128;
+    // Two's complement negation by mask, not a branch on the sign (which
+    // samples of spectral renders flip unpredictably).
+    let negative = i128::from((value.to_bits() as i64) >> 63);
+    (magnitude ^ negative) - negative
 }
 
-/// A non-negative `value` (< 2⁶³) with 32 fractional bits, rounded toward zero.
+/// A non-negative `value` (finite, < 2⁶³) with 32 fractional bits, rounded
+/// toward zero: trunc(value · 2³²).
 #[inline]
 fn fixed_32(value: f64) -> u128 {
-    let whole = value as u64;
-    let fraction = ((value - whole as f64) * TWO_POW_32) as u64;
-    ((whole as u128) << 32) | fraction as u128
+    truncated_fixed_point(value, SQUARE_FRACTION_BITS)
+}
+
+/// trunc(|value| · 2^`fraction_bits`) for finite |value| below
+/// 2^(117 − `fraction_bits`) (2⁵³ for 64 fractional bits, 2⁸⁵ for 32), read
+/// off the bits: |value| = m · 2^(e − 1075) for the 53-bit significand m and
+/// biased exponent e (taken as 1 for subnormals, whose m lacks the implicit
+/// bit), so the fixed-point value is m · 2^(e − 1075 + `fraction_bits`) =
+/// (m · 2⁶⁴) >> (1139 − `fraction_bits` − e). In that range the shift is
+/// not negative, and a right shift drops exactly the bits below the point,
+/// i.e. truncates; m · 2⁶⁴ < 2¹¹⁷, so shifts of 127 and more give 0 and the
+/// shift is clamped there. Floating-point to integer conversions cost more
+/// here: x86-64 has none for unsigned or 128-bit integers, and Rust's
+/// saturating casts add range checks.
+#[inline]
+fn truncated_fixed_point(value: f64, fraction_bits: u32) -> u128 {
+    const SIGNIFICAND_BITS: u32 = 52;
+    let bits = value.to_bits();
+    let biased_exponent = ((bits >> SIGNIFICAND_BITS) & 0x7ff) as u32;
+    let is_normal = u64::from(biased_exponent != 0);
+    let significand = (bits & ((1 << SIGNIFICAND_BITS) - 1)) | (is_normal << SIGNIFICAND_BITS);
+    let exponent = biased_exponent.max(1);
+    let shift = (1075 + 64 - fraction_bits).saturating_sub(exponent).min(127);
+    (u128::from(significand) << 64) >> shift
 }
 
 /// Running sums of one pixel's samples, exact (see the module doc).
@@ -378,6 +398,47 @@ mod tests {
         }
         // Ten exact copies of the f64 0.1 sum to exactly 10 × it, rounded once.
         assert_eq!(p.sum(), Color::splat(10.0 * 0.1));
+    }
+
+    /// The bit-level conversions against the arithmetic definition
+    /// trunc(v · 2^f) (whole part truncated, the exact fraction scaled),
+    /// over every binade a sample or squared luminance can occupy,
+    /// subnormals and both zeros included.
+    #[test]
+    fn fixed_point_conversions_truncate_like_the_arithmetic_definition() {
+        fn by_arithmetic(value: f64, scale: f64, fraction_bits: u32) -> i128 {
+            let magnitude = value.abs();
+            let whole = magnitude as u64;
+            let fraction = ((magnitude - whole as f64) * scale) as u64;
+            let fixed = (((whole as u128) << fraction_bits) | fraction as u128) as i128;
+            if value < 0.0 { -fixed } else { fixed }
+        }
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut values = vec![
+            0.0,
+            -0.0,
+            f64::MIN_POSITIVE,
+            5e-324,
+            -5e-324,
+            1.0,
+            -1.0,
+            MAX_SAMPLE_VALUE - 1.0,
+        ];
+        for _ in 0..200_000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            // Random significand and sign, exponent from subnormal to 2³¹.
+            let exponent = (state >> 52) % 1054;
+            let bits = (state & ((1 << 52) - 1)) | (exponent << 52) | (state & (1 << 63));
+            values.push(f64::from_bits(bits));
+        }
+        for value in values {
+            assert!(value.abs() < MAX_SAMPLE_VALUE);
+            assert_eq!(fixed_64(value), by_arithmetic(value, TWO_POW_64, 64), "{value:e}");
+            let square = value * value;
+            assert_eq!(fixed_32(square) as i128, by_arithmetic(square, TWO_POW_32, 32), "{square:e}");
+        }
     }
 
     #[test]
