@@ -109,7 +109,7 @@ impl Sphere {
         let distance_squared = (self.center - reference).length_squared();
         let distance = distance_squared.sqrt();
         let cos_max = self.cone_cos_max(reference);
-        let (cos_theta, phi) = warp::square_to_uniform_cone_angles(u, cos_max);
+        let (cos_theta, azimuth) = warp::square_to_uniform_cone_angles(u, cos_max);
         let sin2_theta = (1.0 - cos_theta * cos_theta).max(0.0);
         // Angle α at the centre between the axis and the surface point
         // (law of cosines on the triangle reference–centre–point).
@@ -119,7 +119,7 @@ impl Sphere {
             ((distance_squared + radius_squared - hit_distance * hit_distance) / (2.0 * distance * self.radius)).clamp(-1.0, 1.0);
         let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
         let frame = Frame::from_normal((reference - self.center) / distance);
-        let normal = frame.to_world(DVec3::new(sin_alpha * phi.cos(), sin_alpha * phi.sin(), cos_alpha));
+        let normal = frame.to_world(DVec3::new(sin_alpha * azimuth.x, sin_alpha * azimuth.y, cos_alpha));
         let point = self.center + self.radius * normal;
         let pdf = warp::uniform_cone_pdf(cos_max);
         (pdf.is_finite() && cos_max < 1.0).then_some(ShapeSample {

@@ -6,6 +6,7 @@
 
 use super::BsdfSample;
 use crate::color::Color;
+use crate::math::trig::cos_sin_turns;
 use glam::{DVec2, DVec3};
 use std::f64::consts::PI;
 
@@ -94,10 +95,10 @@ pub fn sample(tint: Color, roughness: f64, wo: DVec3, u: DVec2) -> Option<BsdfSa
     let t2 = vh.cross(t1);
     // Uniform disk point, warped towards the visible half.
     let r = u.x.sqrt();
-    let phi = 2.0 * PI * u.y;
-    let p1 = r * phi.cos();
+    let (cos_phi, sin_phi) = cos_sin_turns(u.y);
+    let p1 = r * cos_phi;
     let s = 0.5 * (1.0 + vh.z);
-    let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * phi.sin();
+    let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * sin_phi;
     let nh = p1 * t1 + p2 * t2 + (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt() * vh;
     // Unstretch to the microfacet normal.
     let h = DVec3::new(a * nh.x, a * nh.y, nh.z.max(1e-12)).normalize();

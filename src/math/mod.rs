@@ -18,6 +18,7 @@ pub mod gamma;
 pub mod quadrature;
 pub mod ray;
 pub mod roots;
+pub mod trig;
 pub mod warp;
 
 pub use aabb::Aabb;

@@ -1,8 +1,9 @@
 //! Warps from the unit square to sampling domains, each with its density
 //! (pbrt-v4 appendix A.5, Nori's warp.cpp).
 
+use super::trig::{cos_sin_eighth, cos_sin_turns};
 use glam::{DVec2, DVec3};
-use std::f64::consts::{FRAC_1_PI, PI};
+use std::f64::consts::{FRAC_1_PI, FRAC_PI_4, PI};
 
 /// Uniform point on the unit disk, Shirley–Chiu concentric map (keeps strata;
 /// Shirley & Chiu 1997, "A Low Distortion Map Between Disk and Square").
@@ -11,12 +12,14 @@ pub fn square_to_concentric_disk(u: DVec2) -> DVec2 {
     if o.x == 0.0 && o.y == 0.0 {
         return DVec2::ZERO;
     }
-    let (r, theta) = if o.x.abs() > o.y.abs() {
-        (o.x, PI / 4.0 * (o.y / o.x))
+    if o.x.abs() > o.y.abs() {
+        let (cos, sin) = cos_sin_eighth(FRAC_PI_4 * (o.y / o.x));
+        o.x * DVec2::new(cos, sin)
     } else {
-        (o.y, PI / 2.0 - PI / 4.0 * (o.x / o.y))
-    };
-    r * DVec2::new(theta.cos(), theta.sin())
+        // θ = π/2 − a: cos θ = sin a, sin θ = cos a.
+        let (cos, sin) = cos_sin_eighth(FRAC_PI_4 * (o.x / o.y));
+        o.y * DVec2::new(sin, cos)
+    }
 }
 
 /// Cosine-weighted direction on the +z hemisphere (Malley's method).
@@ -35,8 +38,8 @@ pub fn cosine_hemisphere_pdf(cos_theta: f64) -> f64 {
 pub fn square_to_uniform_sphere(u: DVec2) -> DVec3 {
     let z = 1.0 - 2.0 * u.x;
     let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = 2.0 * PI * u.y;
-    DVec3::new(r * phi.cos(), r * phi.sin(), z)
+    let (cos_phi, sin_phi) = cos_sin_turns(u.y);
+    DVec3::new(r * cos_phi, r * sin_phi, z)
 }
 
 /// Density of `square_to_uniform_sphere`, per steradian: 1 / 4π.
@@ -44,16 +47,17 @@ pub const UNIFORM_SPHERE_PDF: f64 = 1.0 / (4.0 * PI);
 
 /// Uniform direction in the cone of half-angle `acos(cos_theta_max)` around +z.
 pub fn square_to_uniform_cone(u: DVec2, cos_theta_max: f64) -> DVec3 {
-    let (cos_theta, phi) = square_to_uniform_cone_angles(u, cos_theta_max);
+    let (cos_theta, azimuth) = square_to_uniform_cone_angles(u, cos_theta_max);
     let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-    DVec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
+    DVec3::new(sin_theta * azimuth.x, sin_theta * azimuth.y, cos_theta)
 }
 
 /// The polar angle's cosine and the azimuth of [`square_to_uniform_cone`]:
 /// cos θ uniform in [cos θmax, 1] (the cone's solid angle is linear in cos θ),
-/// φ uniform in [0, 2π).
-pub fn square_to_uniform_cone_angles(u: DVec2, cos_theta_max: f64) -> (f64, f64) {
-    ((1.0 - u.x) + u.x * cos_theta_max, 2.0 * PI * u.y)
+/// and (cos φ, sin φ) for φ uniform in [0, 2π).
+pub fn square_to_uniform_cone_angles(u: DVec2, cos_theta_max: f64) -> (f64, DVec2) {
+    let (cos_phi, sin_phi) = cos_sin_turns(u.y);
+    ((1.0 - u.x) + u.x * cos_theta_max, DVec2::new(cos_phi, sin_phi))
 }
 
 /// Density of `square_to_uniform_cone`, per steradian: one over the cone's

@@ -13,6 +13,7 @@
 //! 1 + cos α = (R + d − r)(R + d + r) / (2 R d).
 
 use crate::math::Frame;
+use crate::math::trig::cos_sin_turns;
 use glam::{DVec2, DVec3};
 use std::f64::consts::PI;
 
@@ -71,7 +72,7 @@ impl SphereCap {
         let cos_theta = 1.0 - versine;
         // sin²θ = (1 − cos θ)(1 + cos θ), exact for the small θ of a small cap.
         let sin_theta = (versine * (2.0 - versine)).max(0.0).sqrt();
-        let (sin_phi, cos_phi) = (2.0 * PI * u.y).sin_cos();
+        let (cos_phi, sin_phi) = cos_sin_turns(u.y);
         let local = DVec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta);
         Frame::from_normal(self.axis).to_world(local).normalize()
     }

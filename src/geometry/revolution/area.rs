@@ -11,6 +11,7 @@ use super::{Revolution, profile_normal};
 use crate::geometry::bezier;
 use crate::geometry::hit::AreaSample;
 use crate::math::gamma;
+use crate::math::trig::cos_sin_turns;
 use glam::{DVec2, DVec3};
 use std::f64::consts::TAU;
 
@@ -52,8 +53,7 @@ impl Revolution {
         } else {
             self.cumulative_area[component - 1]
         };
-        let phi = TAU * u.y.clamp(0.0, 1.0);
-        let (sin_phi, cos_phi) = phi.sin_cos();
+        let (cos_phi, sin_phi) = cos_sin_turns(u.y.clamp(0.0, 1.0));
         let (local_point, local_normal, local_error) = if component < self.segments.len() {
             let segment = &self.segments[component];
             let t = segment.invert_area(target - before);
