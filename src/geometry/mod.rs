@@ -119,10 +119,12 @@ impl Shape {
     /// the same as [`Shape::intersect`] would report for it: it is built
     /// from the test's own results, or (for other shapes) by the same test
     /// again with the bound just above the hit, which finds the same hit.
-    pub fn surface_hit(&self, ray: &Ray, hit: ShapeHit, meshes: &[Mesh]) -> Option<SurfaceHit> {
+    /// Without `with_uv` a sphere's texture coordinates are left (0, 0).
+    pub fn surface_hit(&self, ray: &Ray, hit: ShapeHit, meshes: &[Mesh], with_uv: bool) -> Option<SurfaceHit> {
         match (self, hit) {
             (Shape::Quad(q), ShapeHit::Quad { t, a, b }) => Some(q.surface_hit(t, a, b)),
-            (Shape::Sphere(s), ShapeHit::Sphere(t)) => Some(s.hit_at(ray.at(t), t)),
+            (Shape::Sphere(s), ShapeHit::Sphere(t)) if with_uv => Some(s.hit_at(ray.at(t), t)),
+            (Shape::Sphere(s), ShapeHit::Sphere(t)) => Some(s.hit_at_without_uv(ray.at(t), t)),
             (Shape::AxisBox(b), ShapeHit::AxisBox { t, axis }) => Some(b.surface_hit(ray, axis, t)),
             _ => self.intersect(ray, hit.t().next_up(), meshes),
         }

@@ -68,6 +68,17 @@ impl Sphere {
 
     /// The hit record for a point near the surface, reprojected onto it.
     pub fn hit_at(&self, approximate_point: DVec3, t: f64) -> SurfaceHit {
+        let hit = self.hit_at_without_uv(approximate_point, t);
+        SurfaceHit {
+            uv: Self::uv_of(hit.geometric_normal),
+            ..hit
+        }
+    }
+
+    /// The same record with uv left (0, 0), for materials that read no
+    /// texture: spares the atan2 and acos of [`Sphere::uv_of`].
+    #[inline]
+    pub fn hit_at_without_uv(&self, approximate_point: DVec3, t: f64) -> SurfaceHit {
         let normal = (approximate_point - self.center).normalize();
         let (point, point_error) = self.point_with_normal(normal);
         SurfaceHit {
@@ -76,7 +87,7 @@ impl Sphere {
             point_error,
             geometric_normal: normal,
             shading_normal: normal,
-            uv: Self::uv_of(normal),
+            uv: DVec2::ZERO,
         }
     }
 

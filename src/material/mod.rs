@@ -121,6 +121,18 @@ impl Material {
         matches!(self, Material::Glass { dispersion: Some(_), .. })
     }
 
+    /// True if shading reads a hit's texture coordinates: some texture of
+    /// the material varies over the surface. Hits on other materials may
+    /// skip computing them (a sphere's cost an atan2 and an acos).
+    pub fn reads_uv(&self) -> bool {
+        match self {
+            Material::Diffuse { albedo: texture }
+            | Material::Mirror { tint: texture }
+            | Material::Glossy { tint: texture, .. } => !texture.is_constant(),
+            Material::Glass { .. } | Material::Emissive { .. } => false,
+        }
+    }
+
     /// True if the material scatters light at all.
     pub fn scatters(&self) -> bool {
         !matches!(self, Material::Emissive { .. })

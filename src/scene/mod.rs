@@ -59,6 +59,9 @@ const SHAPE_LEAF: u8 = 1;
 #[derive(Debug)]
 pub struct Scene {
     shapes: Vec<Primitive>,
+    /// Per shape: whether its material reads texture coordinates (so its
+    /// hit record needs them; see [`Material::reads_uv`]).
+    shape_reads_uv: Vec<bool>,
     triangles: Triangles,
     /// The meshes triangles come from (for shading normals and uv), with
     /// positions rounded to the stored form.
@@ -121,8 +124,13 @@ impl Scene {
             .iter()
             .filter_map(|&i| slots[(i - triangle_count) as usize].take())
             .collect();
+        let shape_reads_uv = shapes
+            .iter()
+            .map(|shape| materials.get(shape.material as usize).is_some_and(Material::reads_uv))
+            .collect();
         let mut scene = Self {
             shapes,
+            shape_reads_uv,
             triangles,
             meshes,
             materials,
@@ -307,7 +315,10 @@ impl Scene {
                 })
             }
             Nearest::Shape(index, found) => {
-                let hit = self.shapes[index as usize].shape.surface_hit(ray, found, &self.meshes)?;
+                let with_uv = self.shape_reads_uv[index as usize];
+                let hit = self.shapes[index as usize]
+                    .shape
+                    .surface_hit(ray, found, &self.meshes, with_uv)?;
                 Some(Intersection { hit, primitive: index })
             }
             Nearest::Record(found) => Some(found),

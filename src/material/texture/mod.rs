@@ -46,6 +46,11 @@ pub enum Texture {
 }
 
 impl Texture {
+    /// True if the texture is one colour everywhere (reads nothing of the point).
+    pub fn is_constant(&self) -> bool {
+        matches!(self, Texture::Constant(_))
+    }
+
     /// The reflectance at `at`. A constant is read where it is needed; the
     /// patterns are a call away (the whole `match` inlined into every BSDF
     /// was too large to inline, which cost a call per constant too).
