@@ -9,7 +9,9 @@
 //! C_trav = 1 a split of a range that fits one block never pays, and any
 //! larger range needs more than one leaf anyway, so a range becomes a leaf
 //! exactly when it fits one block of its kind; no SAH is evaluated for it.
-//! Leaves never
+//! The exception is a kind whose block costs more than a traversal step
+//! (four spheres tested at once): a range of it that fits one block is
+//! still split when the SAH says rays would skip enough of it. Leaves never
 //! mix primitive kinds (triangles and other shapes are stored apart), and
 //! subtrees deeper than [`MAX_SAH_DEPTH`] fall back to median splits, which
 //! bounds the depth for any input.
@@ -43,6 +45,28 @@ const _: () = assert!(TRAVERSAL_COST >= 1.0);
 const MAX_SAH_DEPTH: usize = 48;
 /// Most primitives any leaf may hold (the BVH encodes counts 1 to 4).
 pub const MAX_LEAF_SIZE: usize = 4;
+
+/// How the leaves of one kind of primitive are made.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LeafKind {
+    /// Most primitives a leaf holds, tested together as one block: 1, 2 or
+    /// 4 (other sizes are taken as the power of two below, up to
+    /// [`MAX_LEAF_SIZE`]).
+    pub max_size: usize,
+    /// Cost of testing one block, in units of one leaf test of triangles
+    /// (the unit of [`TRAVERSAL_COST`]).
+    pub block_cost: f32,
+}
+
+impl LeafKind {
+    /// Leaves of up to `max_size` primitives whose block costs one traversal step.
+    pub const fn sized(max_size: usize) -> Self {
+        Self {
+            max_size,
+            block_cost: TRAVERSAL_COST,
+        }
+    }
+}
 
 /// A box as two four-lane vectors; lane 3 is zero.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -177,10 +201,9 @@ pub enum BinaryContent {
 }
 
 /// Builds the binary tree over `items`, reordering them into leaf order;
-/// a leaf of kind k holds at most `max_leaf_size[k]` items (1, 2 or 4:
-/// other sizes are taken as the power of two below, up to
-/// [`MAX_LEAF_SIZE`]). `items` must not be empty.
-pub fn build(items: &mut [BuildItem], max_leaf_size: &[usize]) -> Vec<BinaryNode> {
+/// leaves of kind k are made as `kinds[k]` says (one primitive per leaf
+/// for a kind not listed). `items` must not be empty.
+pub fn build(items: &mut [BuildItem], kinds: &[LeafKind]) -> Vec<BinaryNode> {
     let mut nodes = Vec::with_capacity(2 * items.len() / MAX_LEAF_SIZE + 1);
     let (bounds, centroids) = items.iter().fold((Box4::EMPTY, Box4::EMPTY), |(b, c), item| {
         (b.union(&item.bounds), c.include(item.centroid2()))
@@ -191,7 +214,7 @@ pub fn build(items: &mut [BuildItem], max_leaf_size: &[usize]) -> Vec<BinaryNode
         bounds,
         centroids,
     };
-    build_into(items, &range, max_leaf_size, &mut nodes);
+    build_into(items, &range, kinds, &mut nodes);
     nodes
 }
 
@@ -207,8 +230,8 @@ struct Range {
 
 /// Appends the subtree over `items` to `nodes`, with indices relative to
 /// the start of `nodes`.
-fn build_into(items: &mut [BuildItem], range: &Range, max_leaf_size: &[usize], nodes: &mut Vec<BinaryNode>) {
-    let Some((mid, left, right)) = choose_split(items, range, max_leaf_size) else {
+fn build_into(items: &mut [BuildItem], range: &Range, kinds: &[LeafKind], nodes: &mut Vec<BinaryNode>) {
+    let Some((mid, left, right)) = choose_split(items, range, kinds) else {
         nodes.push(BinaryNode {
             bounds: range.bounds,
             content: BinaryContent::Leaf {
@@ -231,8 +254,8 @@ fn build_into(items: &mut [BuildItem], range: &Range, max_leaf_size: &[usize], n
         // append it with its indices shifted.
         let mut right_nodes = Vec::new();
         rayon::join(
-            || build_into(left_items, &left, max_leaf_size, nodes),
-            || build_into(right_items, &right, max_leaf_size, &mut right_nodes),
+            || build_into(left_items, &left, kinds, nodes),
+            || build_into(right_items, &right, kinds, &mut right_nodes),
         );
         let offset = nodes.len() as u32;
         nodes.extend(right_nodes.into_iter().map(|mut node| {
@@ -243,28 +266,29 @@ fn build_into(items: &mut [BuildItem], range: &Range, max_leaf_size: &[usize], n
         }));
         nodes[parent].content = BinaryContent::Interior { right: offset };
     } else {
-        build_into(left_items, &left, max_leaf_size, nodes);
+        build_into(left_items, &left, kinds, nodes);
         let right_index = nodes.len() as u32;
         nodes[parent].content = BinaryContent::Interior { right: right_index };
-        build_into(right_items, &right, max_leaf_size, nodes);
+        build_into(right_items, &right, kinds, nodes);
     }
 }
 
 /// Where to split `items` (reordering them so the left part comes first,
 /// and returning both parts' ranges), or `None` to make them a leaf.
-fn choose_split(items: &mut [BuildItem], range: &Range, max_leaf_size: &[usize]) -> Option<(usize, Range, Range)> {
+fn choose_split(items: &mut [BuildItem], range: &Range, kinds: &[LeafKind]) -> Option<(usize, Range, Range)> {
     let count = items.len();
     if count <= 2 * MAX_LEAF_SIZE {
         // Small enough that kinds matter: separate mixed kinds (each side
         // then may become a leaf); a range of one kind that fits one block
         // is a leaf, since a split costs C_trav + (A_L + A_R) / A ≥ 1 block
-        // (areas are never negative), no less than the leaf's one block.
+        // (areas are never negative), no less than the leaf's one block
+        // (unless a block of its kind costs more than a traversal step).
         let first_kind = items[0].kind;
         if !items.iter().all(|item| item.kind == first_kind) {
             return Some(partition(items, range, |item| item.kind == first_kind));
         }
-        if count <= block_size(first_kind, max_leaf_size) as usize {
-            return None;
+        if count <= block_size(first_kind, kinds) as usize {
+            return split_costly_block(items, range, leaf_kind(first_kind, kinds));
         }
     }
     // From here on the range must be split.
@@ -277,11 +301,31 @@ fn choose_split(items: &mut [BuildItem], range: &Range, max_leaf_size: &[usize])
     let binning = Binning::new(range, extent);
     let mut bins = Bins::EMPTY;
     binning.bin(items, &mut bins);
-    let block_shift = block_size(items[0].kind, max_leaf_size).trailing_zeros();
-    let Some((axis, plane)) = bins.cheapest_plane(count, block_shift) else {
+    let block_shift = block_size(items[0].kind, kinds).trailing_zeros();
+    let Some((axis, plane, _)) = bins.cheapest_plane(count, block_shift) else {
         return Some(median_split(items, range, extent));
     };
     Some(partition(items, range, |item| binning.bins_of(item)[axis] < plane as i32))
+}
+
+/// A range of one kind that fits one block: `None` (a leaf) unless the
+/// kind's block costs more than a traversal step and the SAH finds a split
+/// whose two one-block leaves, entered only by the rays that enter their
+/// boxes, cost less than the block every ray entering the range would
+/// test: C_trav · A + C_block · (A_L + A_R) < C_block · A.
+fn split_costly_block(items: &mut [BuildItem], range: &Range, kind: LeafKind) -> Option<(usize, Range, Range)> {
+    let extent = range.centroids.extent();
+    if kind.block_cost <= TRAVERSAL_COST || items.len() < 2 || extent.iter().all(|&e| e <= 0.0) {
+        return None;
+    }
+    let binning = Binning::new(range, extent);
+    let mut bins = Bins::EMPTY;
+    binning.bin(items, &mut bins);
+    let block_shift = kind.max_size.clamp(1, MAX_LEAF_SIZE).ilog2();
+    let (axis, plane, split_areas) = bins.cheapest_plane(items.len(), block_shift)?;
+    let area = range.bounds.half_area();
+    (TRAVERSAL_COST * area + kind.block_cost * split_areas < kind.block_cost * area)
+        .then(|| partition(items, range, |item| binning.bins_of(item)[axis] < plane as i32))
 }
 
 /// How centroids map to bins: bin ⌊(c − origin) · scale⌋ per axis, clamped
@@ -357,7 +401,7 @@ impl Bins {
     /// three axes are swept together, one per lane; ties go to the lowest
     /// axis, then the lowest plane.
     #[inline(never)]
-    fn cheapest_plane(&self, count: usize, block_shift: u32) -> Option<(usize, usize)> {
+    fn cheapest_plane(&self, count: usize, block_shift: u32) -> Option<(usize, usize, f32)> {
         // From the right: the cost of what lies right of each plane.
         let mut right_cost = [f32x4::ZERO; BIN_COUNT];
         let (mut right, mut right_count) = ([Box4::EMPTY; 3], i32x4::ZERO);
@@ -380,10 +424,10 @@ impl Bins {
             best_plane = better.blend(i32x4::splat(plane as i32), best_plane);
         }
         let (costs, planes) = (best_cost.to_array(), best_plane.to_array());
-        let mut best: Option<(usize, usize)> = None;
+        let mut best: Option<(usize, usize, f32)> = None;
         for (axis, (&cost, &plane)) in costs.iter().zip(&planes).take(3).enumerate() {
-            if cost < best.map_or(f32::INFINITY, |(best_axis, _)| costs[best_axis]) {
-                best = Some((axis, plane as usize));
+            if cost < best.map_or(f32::INFINITY, |(_, _, best_cost)| best_cost) {
+                best = Some((axis, plane as usize, cost));
             }
         }
         best
@@ -407,11 +451,15 @@ fn blocks(count: i32x4, block_shift: u32) -> f32x4 {
     ((count + i32x4::splat((1 << block_shift) - 1)) >> block_shift).round_float()
 }
 
+/// How leaves of `kind` are made: as `kinds` says, else one primitive each.
+fn leaf_kind(kind: u32, kinds: &[LeafKind]) -> LeafKind {
+    kinds.get(kind as usize).copied().unwrap_or(LeafKind::sized(1))
+}
+
 /// Primitives of `kind` tested together, which the SAH counts as one
-/// block: the kind's leaf size (a power of two, see [`build`]).
-fn block_size(kind: u32, max_leaf_size: &[usize]) -> u32 {
-    let size = max_leaf_size.get(kind as usize).copied().unwrap_or(1).clamp(1, MAX_LEAF_SIZE);
-    1 << size.ilog2()
+/// block: the kind's leaf size (a power of two, see [`LeafKind`]).
+fn block_size(kind: u32, kinds: &[LeafKind]) -> u32 {
+    1 << leaf_kind(kind, kinds).max_size.clamp(1, MAX_LEAF_SIZE).ilog2()
 }
 
 /// Splits at the median centroid along the widest axis.
@@ -502,6 +550,36 @@ mod tests {
     }
 
     /// Every item lands in exactly one leaf, leaves hold at most their
+    /// A kind whose block costs four traversal steps: four far-apart boxes
+    /// are split into leaves of their own (a ray entering one box need not
+    /// test the others), four boxes that share most of their space stay one
+    /// leaf; a kind of unit cost makes one leaf of either.
+    #[test]
+    fn costly_blocks_are_split_only_where_boxes_overlap_little() {
+        let leaves = |boxes: &[([f32; 3], [f32; 3])], block_cost: f32| {
+            let mut items: Vec<BuildItem> = boxes
+                .iter()
+                .enumerate()
+                .map(|(i, &(min, max))| item(min, max, i as u32, 0))
+                .collect();
+            let kind = LeafKind { max_size: 4, block_cost };
+            let nodes = build(&mut items, &[kind]);
+            nodes
+                .iter()
+                .filter(|node| matches!(node.content, BinaryContent::Leaf { .. }))
+                .count()
+        };
+        let apart: Vec<_> = (0..4)
+            .map(|i| ([10.0 * i as f32, 0.0, 0.0], [10.0 * i as f32 + 1.0, 1.0, 1.0]))
+            .collect();
+        let shared: Vec<_> = (0..4)
+            .map(|i| ([0.1 * i as f32, 0.0, 0.0], [0.1 * i as f32 + 10.0, 10.0, 10.0]))
+            .collect();
+        assert_eq!(leaves(&apart, 4.0), 4);
+        assert_eq!(leaves(&shared, 4.0), 1);
+        assert_eq!(leaves(&apart, 1.0), 1);
+    }
+
     /// kind's leaf size of one kind, and every node's box contains its children's.
     #[test]
     fn leaves_cover_every_item_once_and_boxes_nest() {
@@ -513,7 +591,7 @@ mod tests {
             })
             .collect();
         let leaf_sizes = [4, 1];
-        let nodes = build(&mut items, &leaf_sizes);
+        let nodes = build(&mut items, &leaf_sizes.map(LeafKind::sized));
         let mut seen = vec![0; items.len()];
         for node in &nodes {
             if let BinaryContent::Leaf { first, count, kind } = node.content {
@@ -547,7 +625,7 @@ mod tests {
     #[test]
     fn identical_boxes_end_in_small_leaves() {
         let mut items: Vec<BuildItem> = (0..1000).map(|i| item([0.0; 3], [1.0; 3], i, 0)).collect();
-        let nodes = build(&mut items, &[MAX_LEAF_SIZE]);
+        let nodes = build(&mut items, &[LeafKind::sized(MAX_LEAF_SIZE)]);
         for node in &nodes {
             if let BinaryContent::Leaf { count, .. } = node.content {
                 assert!(count as usize <= MAX_LEAF_SIZE);

@@ -17,7 +17,7 @@
 //! kind (triangles, or other shapes), numbered within that kind.
 
 use super::bounds::{Bounds32, round_up, sign_mask32};
-use super::build::{self, BinaryContent, BinaryNode, Box4, BuildItem, MAX_LEAF_SIZE};
+use super::build::{self, BinaryContent, BinaryNode, Box4, BuildItem, LeafKind, MAX_LEAF_SIZE};
 use super::collapse::Collapse;
 use crate::math::{Aabb, Ray};
 use arrayvec::ArrayVec;
@@ -25,16 +25,17 @@ use wide::{CmpLe, f32x4};
 
 /// Children per node.
 pub const WIDTH: usize = 4;
-/// Kinds of primitive the leaves distinguish (triangles, shapes).
-pub const KIND_COUNT: usize = 2;
+/// Kinds of primitive the leaves distinguish (the scene's are triangles,
+/// spheres and other shapes).
+pub const KIND_COUNT: usize = 3;
 
 /// A child reference is a node index, or a leaf: `LEAF_BIT`, the kind in
-/// bit 30, the primitive count − 1 in bits 28–29, the first primitive in
-/// the low 28 bits. So one 32-bit word says everything a traversal step
+/// bits 29–30, the primitive count − 1 in bits 27–28, the first primitive
+/// in the low 27 bits. So one 32-bit word says everything a traversal step
 /// needs, and a stack entry (reference and entry distance) is 64 bits.
 const LEAF_BIT: u32 = 1 << 31;
-const KIND_SHIFT: u32 = 30;
-const COUNT_SHIFT: u32 = 28;
+const KIND_SHIFT: u32 = 29;
+const COUNT_SHIFT: u32 = 27;
 const FIRST_MASK: u32 = (1 << COUNT_SHIFT) - 1;
 /// Most primitives of one kind a BVH can index.
 pub const MAX_PRIMITIVES_PER_KIND: usize = 1 << COUNT_SHIFT;
@@ -103,7 +104,7 @@ impl Leaf {
     #[inline(always)]
     fn from_reference(reference: u32) -> Self {
         Leaf {
-            kind: ((reference >> KIND_SHIFT) & 1) as u8,
+            kind: ((reference >> KIND_SHIFT) & 3) as u8,
             first: reference & FIRST_MASK,
             count: ((reference >> COUNT_SHIFT) & 3) + 1,
         }
@@ -135,16 +136,14 @@ impl Bvh {
     /// Returns the tree and, per kind, the order in which the caller must
     /// store that kind's primitives: leaves index into these per-kind lists.
     pub fn build(primitives: &[BuildPrimitive]) -> (Self, [Vec<u32>; KIND_COUNT]) {
-        Self::build_with_leaf_sizes(primitives, [MAX_LEAF_SIZE; KIND_COUNT])
+        Self::build_with_leaf_kinds(primitives, [LeafKind::sized(MAX_LEAF_SIZE); KIND_COUNT])
     }
 
-    /// As [`Bvh::build`], with leaves of kind k holding at most
-    /// `max_leaf_size[k]` primitives (1, 2 or 4; 3 is taken as 2): 1 suits
-    /// primitives whose test costs far more than a box test.
-    pub fn build_with_leaf_sizes(
-        primitives: &[BuildPrimitive],
-        max_leaf_size: [usize; KIND_COUNT],
-    ) -> (Self, [Vec<u32>; KIND_COUNT]) {
+    /// As [`Bvh::build`], with leaves of kind k made as `kinds[k]` says:
+    /// up to 1, 2 or 4 primitives tested together (3 is taken as 2; 1 suits
+    /// primitives whose test costs far more than a box test), and what
+    /// testing them costs against a traversal step.
+    pub fn build_with_leaf_kinds(primitives: &[BuildPrimitive], kinds: [LeafKind; KIND_COUNT]) -> (Self, [Vec<u32>; KIND_COUNT]) {
         if primitives.is_empty() {
             return (
                 Self {
@@ -159,8 +158,7 @@ impl Bvh {
             .enumerate()
             .map(|(i, p)| BuildItem::new(Bounds32::enclosing(&p.bounds), i as u32, p.kind))
             .collect();
-        let max_leaf_size = max_leaf_size.map(|size| size.clamp(1, MAX_LEAF_SIZE));
-        let binary = build::build(&mut items, &max_leaf_size);
+        let binary = build::build(&mut items, &kinds);
 
         // Number each kind's primitives in leaf order.
         let mut orders: [Vec<u32>; KIND_COUNT] = Default::default();
@@ -556,7 +554,7 @@ mod tests {
             .enumerate()
             .map(|(i, b)| BuildPrimitive {
                 bounds: *b,
-                kind: (i % 2) as u8,
+                kind: (i % KIND_COUNT) as u8,
             })
             .collect();
         let (bvh, orders) = Bvh::build(&primitives);

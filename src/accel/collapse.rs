@@ -131,7 +131,7 @@ mod tests {
                 BuildItem::new(Bounds32 { min, max }, index, 0)
             })
             .collect();
-        build(&mut items, &[MAX_LEAF_SIZE])
+        build(&mut items, &[super::super::build::LeafKind::sized(MAX_LEAF_SIZE)])
     }
 
     /// Sum of the wide nodes' areas (in `f64`) below and including the

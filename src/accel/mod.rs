@@ -12,4 +12,5 @@ pub mod build;
 pub mod bvh;
 pub mod collapse;
 
+pub use build::LeafKind;
 pub use bvh::{BuildPrimitive, Bvh, Leaf, TraversalRay};

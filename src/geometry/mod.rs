@@ -17,6 +17,7 @@ pub mod quad;
 pub mod revolution;
 pub mod sampling;
 pub mod sphere;
+pub mod spheres;
 pub mod transform;
 pub mod triangle;
 pub mod triangles;

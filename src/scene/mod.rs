@@ -17,9 +17,10 @@ pub use load::{COORDINATE_LIMIT, LoadedScene, load_scene_bytes, load_scene_file,
 pub use progress::{LoadStage, load_scene_file_with_progress};
 pub use similarity::{Similarity, load_scene_str_placed};
 
-use crate::accel::{BuildPrimitive, Bvh};
+use crate::accel::{BuildPrimitive, Bvh, LeafKind};
 use crate::color::Color;
 use crate::geometry::clipped_sphere::clip_emitters;
+use crate::geometry::spheres::Spheres;
 use crate::geometry::triangle::TriangleRay;
 use crate::geometry::triangles::{LeafHit, TriangleSource, Triangles, store_mesh_positions, stored_position};
 use crate::geometry::{Mesh, Shape, ShapeHit, Sphere, SurfaceHit, Triangle};
@@ -48,17 +49,29 @@ pub struct Intersection {
     pub primitive: u32,
 }
 
-/// BVH leaf kinds: the scene's triangles, and its other shapes.
+/// BVH leaf kinds: the scene's triangles, its spheres (both tested four
+/// at a time), and its other shapes.
 const TRIANGLE_LEAF: u8 = 0;
 const SHAPE_LEAF: u8 = 1;
+const SPHERE_LEAF: u8 = 2;
+/// Cost of one leaf of up to four spheres, in traversal steps.
+const SPHERE_BLOCK_COST: f32 = 4.0;
+/// Fewest spheres in one leaf for sphere leaves to pay (two are tested one
+/// at a time, see `geometry::spheres`).
+const MIN_SPHERES_TOGETHER: usize = 3;
 
 /// Everything a ray can meet; immutable once built.
 ///
-/// Primitives are numbered shapes first (spheres, boxes, quads,
-/// revolutions, in BVH leaf order), then triangles (in leaf order too).
+/// Primitives are numbered shapes first (in BVH leaf order; spheres last,
+/// in their own leaf order, when they have leaves of their own), then
+/// triangles (in leaf order too).
 #[derive(Debug)]
 pub struct Scene {
     shapes: Vec<Primitive>,
+    /// The spheres of `shapes` (its last `spheres.len()`), as their leaves read them.
+    spheres: Spheres,
+    /// Index in `shapes` of the first sphere.
+    first_sphere: u32,
     /// Per shape: whether its material reads texture coordinates (so its
     /// hit record needs them; see [`Material::reads_uv`]).
     shape_reads_uv: Vec<bool>,
@@ -85,6 +98,7 @@ impl Scene {
     pub fn new(primitives: Vec<Primitive>, mut meshes: Vec<Mesh>, materials: Vec<Material>, background: Color) -> Self {
         let anchors: Vec<_> = meshes.iter_mut().map(store_mesh_positions).collect();
         let mut shapes = Vec::new();
+        let mut spheres = Vec::new();
         let mut triangles: Vec<(Triangle, u32)> = Vec::new();
         for primitive in primitives {
             match primitive.shape {
@@ -95,23 +109,54 @@ impl Scene {
                         triangles.push((triangle, primitive.material));
                     }
                 }
+                Shape::Sphere(_) => spheres.push(primitive),
                 _ => shapes.push(primitive),
             }
         }
-        let build_primitives: Vec<BuildPrimitive> = triangles
-            .iter()
-            .map(|(triangle, _)| BuildPrimitive {
-                bounds: triangle.bounds(),
-                kind: TRIANGLE_LEAF,
-            })
-            .chain(shapes.iter().map(|p| BuildPrimitive {
-                bounds: p.shape.bounds(),
-                kind: SHAPE_LEAF,
-            }))
-            .collect();
-        // A leaf holds up to four triangles, but one shape: a sphere or
-        // revolution test costs several box tests, which can cull it.
-        let (bvh, orders) = Bvh::build_with_leaf_sizes(&build_primitives, [4, 1]);
+        // A leaf holds up to four triangles, one other shape (a box or
+        // revolution test costs several box tests, which can cull it), and
+        // up to four spheres tested together, a block the SAH counts as four
+        // traversal steps (so it keeps apart spheres whose boxes overlap
+        // little). Spheres get leaves of their own only where that puts
+        // three or more together (smallpt's walls, whose boxes all hold the
+        // room): elsewhere the third leaf kind costs more than it saves, so
+        // the tree is built again with the spheres among the other shapes.
+        let build = |sphere_leaves: bool| {
+            let sphere_kind = if sphere_leaves { SPHERE_LEAF } else { SHAPE_LEAF };
+            let build_primitives: Vec<BuildPrimitive> = triangles
+                .iter()
+                .map(|(triangle, _)| BuildPrimitive {
+                    bounds: triangle.bounds(),
+                    kind: TRIANGLE_LEAF,
+                })
+                .chain(shapes.iter().map(|p| BuildPrimitive {
+                    bounds: p.shape.bounds(),
+                    kind: SHAPE_LEAF,
+                }))
+                .chain(spheres.iter().map(|p| BuildPrimitive {
+                    bounds: p.shape.bounds(),
+                    kind: sphere_kind,
+                }))
+                .collect();
+            let leaf_kinds = [
+                LeafKind::sized(4),
+                LeafKind::sized(1),
+                LeafKind {
+                    max_size: 4,
+                    block_cost: SPHERE_BLOCK_COST,
+                },
+            ];
+            Bvh::build_with_leaf_kinds(&build_primitives, leaf_kinds)
+        };
+        let (mut bvh, mut orders) = build(spheres.len() >= MIN_SPHERES_TOGETHER);
+        let together = |bvh: &Bvh| {
+            bvh.leaves(SPHERE_LEAF)
+                .iter()
+                .any(|leaf| leaf.count as usize >= MIN_SPHERES_TOGETHER)
+        };
+        if !orders[SPHERE_LEAF as usize].is_empty() && !together(&bvh) {
+            (bvh, orders) = build(false);
+        }
         let triangle_count = triangles.len() as u32;
         let triangles = Triangles::new(
             &triangles,
@@ -119,17 +164,35 @@ impl Scene {
             &bvh.leaves(TRIANGLE_LEAF),
             anchors,
         );
-        let mut slots: Vec<Option<Primitive>> = shapes.into_iter().map(Some).collect();
-        let shapes: Vec<Primitive> = orders[SHAPE_LEAF as usize]
-            .iter()
-            .filter_map(|&i| slots[(i - triangle_count) as usize].take())
-            .collect();
+        // Build indices run triangles, other shapes, spheres; the stored
+        // order is other shapes, then spheres, each in its leaf order.
+        let mut slots: Vec<Option<Primitive>> = shapes.into_iter().chain(spheres).map(Some).collect();
+        let mut take = |kind: u8| -> Vec<Primitive> {
+            orders[kind as usize]
+                .iter()
+                .filter_map(|&i| slots.get_mut((i - triangle_count) as usize)?.take())
+                .collect()
+        };
+        let mut shapes = take(SHAPE_LEAF);
+        let spheres = take(SPHERE_LEAF);
+        let first_sphere = shapes.len() as u32;
+        shapes.extend(spheres);
+        let spheres = Spheres::new(
+            shapes[first_sphere as usize..]
+                .iter()
+                .filter_map(|primitive| match &primitive.shape {
+                    Shape::Sphere(sphere) => Some(sphere),
+                    _ => None,
+                }),
+        );
         let shape_reads_uv = shapes
             .iter()
             .map(|shape| materials.get(shape.material as usize).is_some_and(Material::reads_uv))
             .collect();
         let mut scene = Self {
             shapes,
+            spheres,
+            first_sphere,
             shape_reads_uv,
             triangles,
             meshes,
@@ -288,6 +351,11 @@ impl Scene {
                     *t_max = found.hit.t;
                     nearest = Nearest::Triangle(found);
                 }
+            } else if leaf.kind == SPHERE_LEAF {
+                if let Some(found) = self.spheres.intersect_leaf(ray, leaf.first, leaf.count, *t_max) {
+                    *t_max = found.t;
+                    nearest = Nearest::Shape(self.first_sphere + found.index, ShapeHit::Sphere(found.t));
+                }
             } else {
                 for index in leaf.first..leaf.first + leaf.count {
                     let shape = &self.shapes[index as usize].shape;
@@ -336,6 +404,8 @@ impl Scene {
             found = if leaf.kind == TRIANGLE_LEAF {
                 let triangle_ray = triangle_ray.get_or_insert_with(|| TriangleRay::new(ray));
                 self.triangles.occludes_leaf(triangle_ray, leaf.first, leaf.count, *t_max)
+            } else if leaf.kind == SPHERE_LEAF {
+                self.spheres.occludes_leaf(ray, leaf.first, leaf.count, *t_max)
             } else {
                 (leaf.first..leaf.first + leaf.count)
                     .any(|index| self.shapes[index as usize].shape.hit_distance(ray, *t_max).is_some())
