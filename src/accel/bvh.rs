@@ -14,7 +14,7 @@
 //!
 //! The BVH knows only boxes and leaves: what a leaf's primitives are, and
 //! how to hit them, is the caller's closure. Leaves hold primitives of one
-//! kind (triangles, or other shapes), numbered within that kind.
+//! kind (the scene's: triangles, spheres, other shapes), numbered within that kind.
 
 use super::bounds::{Bounds32, round_up, sign_mask32};
 use super::build::{self, BinaryContent, BinaryNode, Box4, BuildItem, LeafKind, MAX_LEAF_SIZE};
