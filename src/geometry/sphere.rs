@@ -49,10 +49,17 @@ impl Sphere {
             let a = c / q;
             if a < q { (a, q) } else { (q, a) }
         };
-        if t0 > 0.0 && t0 < t_max {
-            Some(t0)
-        } else if t1 > 0.0 && t1 < t_max {
-            Some(t1)
+        Self::root_within(t0, t1, t_max)
+    }
+
+    /// The root a hit reports, given both roots nearer first: the nearer
+    /// one in `(0, t_max)`, else the farther one there (a ray from inside).
+    #[inline(always)]
+    pub fn root_within(near: f64, far: f64, t_max: f64) -> Option<f64> {
+        if near > 0.0 && near < t_max {
+            Some(near)
+        } else if far > 0.0 && far < t_max {
+            Some(far)
         } else {
             None
         }

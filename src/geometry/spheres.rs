@@ -62,14 +62,7 @@ impl Roots {
     /// The root the scalar test reports for `lane` under the bound `t_max`.
     #[inline(always)]
     fn within(&self, lane: usize, t_max: f64) -> Option<f64> {
-        let (near, far) = (self.near[lane], self.far[lane]);
-        if near > 0.0 && near < t_max {
-            Some(near)
-        } else if far > 0.0 && far < t_max {
-            Some(far)
-        } else {
-            None
-        }
+        Sphere::root_within(self.near[lane], self.far[lane], t_max)
     }
 }
 
