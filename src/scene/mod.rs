@@ -121,8 +121,13 @@ impl Scene {
         // three or more together (smallpt's walls, whose boxes all hold the
         // room): elsewhere the third leaf kind costs more than it saves, so
         // the tree is built again with the spheres among the other shapes.
-        let build = |sphere_leaves: bool| {
+        // `spheres_only` builds over the spheres alone.
+        let build = |sphere_leaves: bool, spheres_only: bool| {
             let sphere_kind = if sphere_leaves { SPHERE_LEAF } else { SHAPE_LEAF };
+            let (triangles, shapes) = match spheres_only {
+                true => (&triangles[..0], &shapes[..0]),
+                false => (&triangles[..], &shapes[..]),
+            };
             let build_primitives: Vec<BuildPrimitive> = triangles
                 .iter()
                 .map(|(triangle, _)| BuildPrimitive {
@@ -148,14 +153,21 @@ impl Scene {
             ];
             Bvh::build_with_leaf_kinds(&build_primitives, leaf_kinds)
         };
-        let (mut bvh, mut orders) = build(spheres.len() >= MIN_SPHERES_TOGETHER);
         let together = |bvh: &Bvh| {
             bvh.leaves(SPHERE_LEAF)
                 .iter()
                 .any(|leaf| leaf.count as usize >= MIN_SPHERES_TOGETHER)
         };
-        if !orders[SPHERE_LEAF as usize].is_empty() && !together(&bvh) {
-            (bvh, orders) = build(false);
+        // Whether to try sphere leaves. Where the spheres are a minority (a
+        // mesh and a few spheres), a tree of the spheres alone answers first,
+        // at a cost that grows with the spheres only, so that the mesh's tree
+        // is not built twice when they would not share a leaf anyway.
+        let other_count = triangles.len() + shapes.len();
+        let sphere_leaves =
+            spheres.len() >= MIN_SPHERES_TOGETHER && (other_count <= spheres.len() || together(&build(true, true).0));
+        let (mut bvh, mut orders) = build(sphere_leaves, false);
+        if sphere_leaves && !together(&bvh) {
+            (bvh, orders) = build(false, false);
         }
         let triangle_count = triangles.len() as u32;
         let triangles = Triangles::new(
@@ -432,5 +444,78 @@ impl EmitterSource for Scene {
             Some(triangle) => Emitter::Triangle(self.triangles.get(triangle)),
             None => Emitter::Shape(&self.shapes[primitive as usize].shape),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    /// A floor of `side`² × 2 small triangles around the origin, then `spheres`.
+    fn floor_and_spheres(side: usize, spheres: &[Sphere]) -> Scene {
+        let mut primitives = Vec::new();
+        for i in 0..side {
+            for j in 0..side {
+                let corner = |di: usize, dj: usize| DVec3::new((i + di) as f64, 0.0, (j + dj) as f64);
+                for (face, vertices) in [
+                    [corner(0, 0), corner(1, 0), corner(1, 1)],
+                    [corner(0, 0), corner(1, 1), corner(0, 1)],
+                ]
+                .into_iter()
+                .enumerate()
+                {
+                    let triangle = Triangle {
+                        vertices,
+                        mesh: 0,
+                        face: face as u32,
+                    };
+                    primitives.push(Primitive {
+                        shape: Shape::Triangle(triangle),
+                        material: 0,
+                    });
+                }
+            }
+        }
+        primitives.extend(spheres.iter().map(|&sphere| Primitive {
+            shape: Shape::Sphere(sphere),
+            material: 0,
+        }));
+        let materials = vec![Material::Diffuse {
+            albedo: Texture::Constant(Color::splat(0.5)),
+        }];
+        Scene::new(primitives, Vec::new(), materials, Color::ZERO)
+    }
+
+    /// Spheres among many triangles get leaves of their own where three or
+    /// more share one (walls of radius 10⁵ whose boxes all hold the floor,
+    /// as in smallpt), and not where none would (three small spheres far
+    /// apart, which the tree of the spheres alone already keeps apart).
+    #[test]
+    fn spheres_among_triangles_share_leaves_only_where_three_overlap() {
+        // A room 32 wide around the floor, walled by spheres as in smallpt.
+        let wall = |axis: usize, side: f64| {
+            let mut center = DVec3::splat(15.0);
+            center[axis] = 15.0 + side * (1e5 + 16.0);
+            Sphere { center, radius: 1e5 }
+        };
+        let walls = [0, 1, 2].map(|axis| [wall(axis, -1.0), wall(axis, 1.0)]).concat();
+        let scene = floor_and_spheres(4, &walls);
+        assert!(scene.triangles.len() > walls.len());
+        let leaves = scene.bvh.leaves(SPHERE_LEAF);
+        assert_eq!(leaves.iter().map(|leaf| leaf.count).sum::<u32>(), 6, "{leaves:?}");
+
+        let apart = [-20.0, 5.0, 30.0].map(|x| Sphere {
+            center: DVec3::new(x, 3.0, x),
+            radius: 0.5,
+        });
+        let scene = floor_and_spheres(30, &apart);
+        assert!(scene.bvh.leaves(SPHERE_LEAF).is_empty());
+        assert_eq!(scene.bvh.leaves(SHAPE_LEAF).len(), 3);
+
+        // Either way the spheres are found where they are.
+        let ray = Ray::new(DVec3::new(5.0, 10.0, 5.0), DVec3::NEG_Y);
+        let hit = scene.intersect(&ray, f64::INFINITY).map(|found| found.hit.t);
+        assert_eq!(hit, Some(6.5));
     }
 }
