@@ -13,7 +13,8 @@
 //! With the per-pixel schedule (Hachisuka & Jensen) the image is
 //! τ / (π R² · photons emitted) plus the emission camera paths saw along
 //! their specular chains, averaged over iterations (with a few extra camera
-//! paths per iteration for that cheap term). With the global schedule
+//! paths per iteration for that cheap term, in the pixels that may see
+//! emission: [`emission_paths`]). With the global schedule
 //! (Knaus & Zwicker 2011) every iteration i is a complete estimate, emission
 //! plus Φᵢ / (π rᵢ² · photons per iteration), and the image is their mean:
 //! iterations are independent, so a range of them renders on any machine and
@@ -33,6 +34,7 @@
 //! point (flux times the visible point's BSDF, both at the photon's
 //! wavelengths) enters the pixel's tally as film RGB.
 
+pub mod emission_paths;
 pub mod grid;
 pub mod photon;
 pub mod radius;
@@ -66,7 +68,8 @@ use visible_point::{VisiblePoint, trace_camera_path, trace_emission_path};
 const PHOTON_SEED: u64 = 0x5eed_0f94_0705_eed1;
 
 /// Camera paths per pixel and iteration for the emitted term (lights seen
-/// directly or through glass and mirrors). Only the first leaves a visible
+/// directly or through glass and mirrors) where a pixel may see emission
+/// ([`emission_paths`]; elsewhere one). Only the first leaves a visible
 /// point; the others are cheap (they stop at the first diffuse surface) and
 /// cut the noise of small, bright light images, which would otherwise get
 /// only one sample per photon pass.
@@ -131,6 +134,10 @@ pub struct SppmIntegrator {
     samples: Vec<CameraSample>,
     /// The grid over the gather spheres, rebuilt in place every iteration.
     grid: VisiblePointGrid,
+    /// Per pixel, whether its footprint may see emission, so that it traces
+    /// `EMISSION_SAMPLES` camera paths for the emitted term rather than one;
+    /// found at the first iteration (a new camera starts a new render).
+    may_see_emission: Vec<bool>,
     /// Index of the first iteration (a farm share may start past 0).
     first_iteration: u32,
     iterations: u32,
@@ -168,6 +175,7 @@ impl SppmIntegrator {
             tallies: (0..count).map(|_| PhotonTally::default()).collect(),
             samples: vec![CameraSample::SKIPPED; count],
             grid: VisiblePointGrid::default(),
+            may_see_emission: Vec::new(),
             first_iteration: share.samples.start,
             iterations: 0,
             rejected: 0,
@@ -227,7 +235,11 @@ impl SppmIntegrator {
             // The emitted term: this path and a few more, from their own
             // Sobol' stream so each stream stays stratified over iterations.
             let mut emitted = path.emitted;
-            for extra in 0..EMISSION_SAMPLES - 1 {
+            let paths = match self.may_see_emission.get(index) {
+                Some(false) => 1,
+                _ => EMISSION_SAMPLES,
+            };
+            for extra in 0..paths - 1 {
                 let mut sampler = Sampler::new(
                     kind,
                     index as u64,
@@ -237,7 +249,7 @@ impl SppmIntegrator {
                 let ray = camera_ray(camera, size, x, y, &mut sampler);
                 emitted += trace_emission_path::<C>(scene, ray, &mut sampler, max_depth);
             }
-            let emitted = emitted / EMISSION_SAMPLES as f64;
+            let emitted = emitted / paths as f64;
             CameraSample {
                 sampled: true,
                 visible: path.visible_point.filter(|vp| vp.throughput.is_finite()),
@@ -406,6 +418,11 @@ impl Integrator for SppmIntegrator {
         let start = Instant::now();
         // RGB or spectral, chosen once per pass: each is its own compiled loop.
         let spectral = self.settings.spectral || scene.has_dispersion();
+        if self.may_see_emission.is_empty() {
+            let size = (self.width, self.height);
+            self.may_see_emission =
+                emission_paths::pixels_that_may_see_emission(scene, camera, size, self.settings.sampled_pixels());
+        }
         let mut visible = std::mem::take(&mut self.samples);
         match spectral {
             true => self.camera_pass::<SampledSpectrum>(scene, camera, cancel, &mut visible),
