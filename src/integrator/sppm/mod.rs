@@ -269,28 +269,30 @@ impl SppmIntegrator {
     fn radii_for_iteration(&mut self, camera: &Camera, samples: &[CameraSample]) -> Vec<f64> {
         let initial_radius = InitialRadius::new(&self.parameters, camera, self.height);
         let linear_scale = global_area_scale(self.iteration(), self.parameters.alpha).sqrt();
-        let mut rejected = 0;
-        let radii = match &mut self.estimate {
-            Estimate::Progressive(pixels) => pixels
-                .iter_mut()
-                .zip(samples)
-                .map(|(pixel, sample)| {
-                    match sample.emitted {
-                        Some(emitted) => pixel.emitted_sum += emitted,
-                        None if sample.sampled => rejected += 1,
-                        None => {}
-                    }
-                    if pixel.radius == 0.0 {
-                        pixel.radius = sample
-                            .visible
-                            .as_ref()
-                            .map_or(0.0, |vp| initial_radius.at_distance(vp.path_length));
-                    }
-                    pixel.radius
-                })
-                .collect(),
+        match &mut self.estimate {
+            Estimate::Progressive(pixels) => {
+                // Sampled pixels whose emitted term was not finite (the global
+                // schedule counts them as it adds to its film).
+                self.rejected += samples.par_iter().filter(|s| s.sampled && s.emitted.is_none()).count() as u64;
+                pixels
+                    .par_iter_mut()
+                    .zip(samples.par_iter())
+                    .map(|(pixel, sample)| {
+                        if let Some(emitted) = sample.emitted {
+                            pixel.emitted_sum += emitted;
+                        }
+                        if pixel.radius == 0.0 {
+                            pixel.radius = sample
+                                .visible
+                                .as_ref()
+                                .map_or(0.0, |vp| initial_radius.at_distance(vp.path_length));
+                        }
+                        pixel.radius
+                    })
+                    .collect()
+            }
             Estimate::Independent { .. } => samples
-                .iter()
+                .par_iter()
                 .map(|sample| {
                     sample
                         .visible
@@ -298,9 +300,7 @@ impl SppmIntegrator {
                         .map_or(0.0, |vp| initial_radius.at_distance(vp.path_length) * linear_scale)
                 })
                 .collect(),
-        };
-        self.rejected += rejected;
-        radii
+        }
     }
 
     /// Step 3: traces this iteration's photons in parallel, adding to the
