@@ -334,6 +334,7 @@ fn a_light_between_the_probes_is_counted_in_full() {
         &loaded.camera,
         (settings.width, settings.height),
         settings.sampled_pixels(),
+        settings.max_depth,
     );
     assert!(flagged.iter().all(|&f| !f), "the probes should miss the light");
 

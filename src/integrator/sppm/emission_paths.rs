@@ -8,9 +8,16 @@
 //! integrator's `EMISSION_SAMPLES`) pay only in pixels whose footprint may
 //! first meet an emitter, a mirror or glass, or the background. Those
 //! pixels are found once per render by probe rays through fixed points of
-//! each pixel, dilated by one pixel so that the image of a light or a glass
-//! object seen at a neighbour's centre counts here too; the others trace
-//! only the path that also leaves their visible point.
+//! each pixel, dilated by one pixel so that the image of a light seen at a
+//! neighbour's centre counts here too; the others trace only the path that
+//! also leaves their visible point.
+//!
+//! A probe that meets a mirror or glass follows every specular branch whose
+//! lobe probabilities multiply to at least [`BRANCH_CUTOFF`] (both the
+//! reflection and the refraction of glass, weighted by Fresnel's
+//! reflectance), so a glass object is flagged only where a light or a
+//! shining background can be seen in it or through it: a camera path
+//! through glass that ends on a diffuse surface also finds no emission.
 //!
 //! The estimate stays unbiased whatever the probes find: how many paths a
 //! pixel traces depends on the scene and the camera alone, never on the
@@ -22,10 +29,25 @@
 
 use crate::camera::Camera;
 use crate::color::Color;
-use crate::math::DVec2;
+use crate::material::{ShadingPoint, Transport};
+use crate::math::{DVec2, Frame as ShadingFrame, Ray};
 use crate::scene::Scene;
 use crate::settings::PixelRect;
+use arrayvec::ArrayVec;
 use rayon::prelude::*;
+
+/// The smallest product of lobe probabilities a probe still follows through
+/// mirrors and glass. Fresnel reflection off glass (≈ 4% at normal
+/// incidence) is followed once, not twice: a light seen only after two
+/// partial reflections is dim and rare, and its pixels are only noisier.
+const BRANCH_CUTOFF: f64 = 0.01;
+
+/// Ray casts one probe may make through specular chains; a probe that needs
+/// more (a hall of mirrors) flags its pixel rather than searching on.
+const PROBE_CASTS: u32 = 32;
+
+/// Specular branches a probe keeps waiting at once.
+const PROBE_BRANCHES: usize = 16;
 
 /// Points on the lens a thin-lens camera's probes start from, as lens
 /// samples in \[0,1\]²: the centre and four points at 0.7 of its radius (a
@@ -47,6 +69,7 @@ pub fn pixels_that_may_see_emission(
     camera: &Camera,
     (width, height): (u32, u32),
     sampled: PixelRect,
+    max_depth: u32,
 ) -> Vec<bool> {
     let lens_points: &[DVec2] = if camera.has_lens() { &LENS_PROBES } else { &LENS_PROBES[..1] };
     let background_shines = scene.background != Color::ZERO;
@@ -64,13 +87,7 @@ pub fn pixels_that_may_see_emission(
             let film = DVec2::new((x as f64 + 0.5) / width as f64, (y as f64 + 0.5) / height as f64);
             lens_points.iter().any(|&lens| {
                 let ray = camera.generate_ray(film, width as f64 / height as f64, lens);
-                match scene.intersect(&ray, f64::INFINITY) {
-                    None => background_shines,
-                    Some(found) => {
-                        let material = scene.material_of(found.primitive);
-                        !material.scatters() || material.is_specular()
-                    }
-                }
+                probe_finds_emission(scene, ray, background_shines, max_depth)
             })
         })
         .collect();
@@ -84,6 +101,61 @@ pub fn pixels_that_may_see_emission(
             (y0..=y1).any(|ny| (x0..=x1).any(|nx| probed[ny * width as usize + nx]))
         })
         .collect()
+}
+
+/// Whether a camera path along `ray` may collect emission: it meets an
+/// emitter, or escapes into a shining background, directly or through
+/// mirrors and glass, following each specular branch that is likely enough
+/// (see [`BRANCH_CUTOFF`]) for up to `max_depth` bounces, as camera paths do.
+fn probe_finds_emission(scene: &Scene, ray: Ray, background_shines: bool, max_depth: u32) -> bool {
+    // (ray, product of the lobe probabilities so far, bounces so far)
+    let mut branches: ArrayVec<(Ray, f64, u32), PROBE_BRANCHES> = ArrayVec::new();
+    branches.push((ray, 1.0, 0));
+    let mut casts = 0;
+    while let Some((ray, probability, depth)) = branches.pop() {
+        casts += 1;
+        if casts > PROBE_CASTS {
+            return true;
+        }
+        let Some(found) = scene.intersect(&ray, f64::INFINITY) else {
+            if background_shines {
+                return true;
+            }
+            continue;
+        };
+        let material = scene.material_of(found.primitive);
+        if !material.scatters() {
+            return true;
+        }
+        if !material.is_specular() || depth >= max_depth {
+            continue;
+        }
+        let hit = found.hit;
+        let frame = ShadingFrame::from_normal(hit.shading_normal);
+        let wo = frame.to_local(-ray.direction);
+        let at = ShadingPoint {
+            uv: hit.uv,
+            point: hit.point,
+        };
+        // The lobe sample picks reflection below Fresnel's reflectance and
+        // refraction above it: these two reach both lobes where both exist.
+        let mut followed: Option<crate::math::DVec3> = None;
+        for u_lobe in [0.0, 1.0 - f64::EPSILON / 2.0] {
+            let Some(sample) = material.sample(wo, &at, DVec2::splat(0.5), u_lobe, Transport::Radiance) else {
+                continue;
+            };
+            let probability = probability * sample.pdf.min(1.0);
+            if followed == Some(sample.wi) || probability < BRANCH_CUTOFF {
+                continue;
+            }
+            followed = Some(sample.wi);
+            let next = Ray::spawn(hit.point, hit.point_error, hit.geometric_normal, frame.to_world(sample.wi));
+            if branches.try_push((next, probability, depth + 1)).is_err() {
+                return true;
+            }
+        }
+    }
+    false
 }
 
 #[cfg(test)]
@@ -137,39 +209,76 @@ mod tests {
             &loaded.camera,
             (width, height),
             loaded.settings.sampled_pixels(),
+            loaded.settings.max_depth,
         );
         (flags, width, height)
     }
 
-    /// The pixels flagged are the ball's and the light's images and a
-    /// one-pixel ring around them: every pixel whose centre sees either is
-    /// flagged, and every pixel with no such centre within one pixel is not.
+    /// The material a pixel's centre sees first.
+    fn seen_at_centre(loaded: &crate::scene::LoadedScene, x: i64, y: i64) -> Option<&'static str> {
+        let (width, height) = (loaded.settings.width as i64, loaded.settings.height as i64);
+        if x < 0 || y < 0 || x >= width || y >= height {
+            return None;
+        }
+        let film = DVec2::new((x as f64 + 0.5) / width as f64, (y as f64 + 0.5) / height as f64);
+        let ray = loaded
+            .camera
+            .generate_ray(film, width as f64 / height as f64, DVec2::splat(0.5));
+        let found = loaded.scene.intersect(&ray, f64::INFINITY)?;
+        Some(match loaded.scene.material_of(found.primitive) {
+            crate::material::Material::Emissive { .. } => "light",
+            crate::material::Material::Glass { .. } => "glass",
+            _ => "other",
+        })
+    }
+
+    /// The light's image and a one-pixel ring around it are flagged; the
+    /// glass ball, through which the camera sees only the diffuse wall, is
+    /// not (but for the few pixels that show the light reflected in it).
     #[test]
-    fn flags_the_images_of_lights_and_glass_and_their_neighbours() {
+    fn flags_the_image_of_a_light_and_its_neighbours_not_glass_that_shows_none() {
         let loaded = load_scene_str(WALL_BALL_LIGHT, Path::new("<test>"), Path::new(".")).expect("test scene parses");
         let (flags, width, height) = flagged(WALL_BALL_LIGHT);
-        let sees = |x: i64, y: i64| {
-            if x < 0 || y < 0 || x >= width as i64 || y >= height as i64 {
-                return false;
-            }
-            let film = DVec2::new((x as f64 + 0.5) / width as f64, (y as f64 + 0.5) / height as f64);
-            let ray = loaded
-                .camera
-                .generate_ray(film, width as f64 / height as f64, DVec2::splat(0.5));
-            let found = loaded.scene.intersect(&ray, f64::INFINITY).expect("the wall fills the view");
-            let material = loaded.scene.material_of(found.primitive);
-            !matches!(material, crate::material::Material::Diffuse { .. })
-        };
-        let mut count = 0;
+        let (mut light_ring, mut glass, mut glass_flagged) = (0, 0, 0);
         for y in 0..height as i64 {
             for x in 0..width as i64 {
-                let near = (-1..=1).any(|dy| (-1..=1).any(|dx| sees(x + dx, y + dy)));
-                assert_eq!(flags[(y * width as i64 + x) as usize], near, "pixel ({x}, {y})");
-                count += usize::from(near);
+                let flag = flags[(y * width as i64 + x) as usize];
+                let near_light = (-1..=1).any(|dy| (-1..=1).any(|dx| seen_at_centre(&loaded, x + dx, y + dy) == Some("light")));
+                if near_light {
+                    assert!(flag, "pixel ({x}, {y}) is next to the light's image");
+                    light_ring += 1;
+                } else if seen_at_centre(&loaded, x, y) == Some("glass") {
+                    glass += 1;
+                    glass_flagged += usize::from(flag);
+                }
             }
         }
-        // Both objects are seen, and most of the wall is not flagged.
-        assert!(count > 20 && count < flags.len() / 3, "{count} of {} flagged", flags.len());
+        assert!(light_ring >= 9, "{light_ring} pixels around the light");
+        assert!(glass > 30, "{glass} pixels see the ball");
+        assert!(glass_flagged * 4 < glass, "{glass_flagged} of {glass} glass pixels flagged");
+    }
+
+    /// A light seen only through a glass ball (behind it, on the camera's
+    /// axis) flags the ball's centre; the same ball in front of a diffuse
+    /// sphere flags nothing.
+    #[test]
+    fn a_light_seen_through_glass_is_flagged() {
+        let behind = WALL_BALL_LIGHT
+            .replace("center = [-1.5, 0, 0]", "center = [0, 0, 0]")
+            .replace("center = [2, 1, 0]", "center = [0, 0, 2]");
+        let loaded = load_scene_str(&behind, Path::new("<test>"), Path::new(".")).expect("test scene parses");
+        let (flags, width, height) = flagged(&behind);
+        let (cx, cy) = (width as i64 / 2, height as i64 / 2);
+        assert_eq!(seen_at_centre(&loaded, cx, cy), Some("glass"));
+        assert!(flags[(cy * width as i64 + cx) as usize], "the light behind the ball");
+
+        let dark = behind.replace(
+            "type = \"emissive\"\n        radiance = [5, 5, 5]",
+            "type = \"diffuse\"\n        albedo = [0.5, 0.5, 0.5]",
+        );
+        assert_ne!(dark, behind);
+        let (flags, ..) = flagged(&dark);
+        assert!(flags.iter().all(|&f| !f), "nothing emits");
     }
 
     /// A non-black background is emission too: pixels seeing it are flagged.

@@ -421,7 +421,7 @@ impl Integrator for SppmIntegrator {
         if self.may_see_emission.is_empty() {
             let size = (self.width, self.height);
             self.may_see_emission =
-                emission_paths::pixels_that_may_see_emission(scene, camera, size, self.settings.sampled_pixels());
+                emission_paths::pixels_that_may_see_emission(scene, camera, size, self.settings.sampled_pixels(), self.max_depth);
         }
         let mut visible = std::mem::take(&mut self.samples);
         match spectral {
