@@ -6,7 +6,8 @@
 //! diffuse or glossy surface. A path whose first surface is diffuse or
 //! glossy therefore contributes exactly zero, and extra paths (the
 //! integrator's `EMISSION_SAMPLES`) pay only in pixels whose footprint may
-//! first meet an emitter, a mirror or glass, or the background. Those
+//! meet an emitter or a shining background, directly or through mirrors
+//! and glass. Those
 //! pixels are found once per render by probe rays through fixed points of
 //! each pixel, dilated by one pixel so that the image of a light seen at a
 //! neighbour's centre counts here too; the others trace only the path that
@@ -30,7 +31,7 @@
 use crate::camera::Camera;
 use crate::color::Color;
 use crate::material::{ShadingPoint, Transport};
-use crate::math::{DVec2, Frame as ShadingFrame, Ray};
+use crate::math::{DVec2, DVec3, Frame as ShadingFrame, Ray};
 use crate::scene::Scene;
 use crate::settings::PixelRect;
 use arrayvec::ArrayVec;
@@ -139,7 +140,7 @@ fn probe_finds_emission(scene: &Scene, ray: Ray, background_shines: bool, max_de
         };
         // The lobe sample picks reflection below Fresnel's reflectance and
         // refraction above it: these two reach both lobes where both exist.
-        let mut followed: Option<crate::math::DVec3> = None;
+        let mut followed: Option<DVec3> = None;
         for u_lobe in [0.0, 1.0 - f64::EPSILON / 2.0] {
             let Some(sample) = material.sample(wo, &at, DVec2::splat(0.5), u_lobe, Transport::Radiance) else {
                 continue;
