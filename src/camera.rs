@@ -30,6 +30,22 @@ pub struct Camera {
     basis: Basis,
 }
 
+/// A surface point seen from the lens: see [`Camera::connect`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FilmConnection {
+    /// Where on the film, in \[0,1)² (x right, y down).
+    pub film: DVec2,
+    /// Unit direction from the point towards the lens point.
+    pub towards_lens: DVec3,
+    /// Length of the segment from the point that must be unoccluded (up to
+    /// the near-clip plane, or to the lens).
+    pub clear_distance: f64,
+    /// |cos θₓ| · weight is the film-wide measurement per unit radiance
+    /// leaving the point towards the lens (θₓ: between that direction and
+    /// the surface normal); divide by the pixel's fraction of the film.
+    pub weight: f64,
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Basis {
     right: DVec3,
@@ -120,6 +136,62 @@ impl Camera {
         ray
     }
 
+    /// How a world `point` shows on the film through the lens point that
+    /// `lens` picks (as in [`generate_ray`](Self::generate_ray)): the
+    /// adjoint of a camera ray, for paths traced from the lights. `None` if
+    /// the point is behind the lens or the near-clip plane, or off the film.
+    ///
+    /// Why the weight: a pixel's estimate is the mean radiance over the
+    /// camera rays through it, film positions uniform on the pixel and lens
+    /// points uniform on the aperture. On the film plane at unit distance a
+    /// ray making angle θ with the view axis maps film area to solid angle
+    /// as dω = cos³θ dA (and the same holds from any lens point through the
+    /// focal plane); solid angle at the lens maps to area at the point as
+    /// dω = |cos θₓ| dAₓ / d². So radiance L leaving the point towards the
+    /// lens adds L · |cos θₓ| / (A · cos³θ · d²) to the film-wide mean, A
+    /// being the film's area at unit distance; a pixel covering a fraction a
+    /// of the film receives that divided by a (the importance We of pbrt-v3
+    /// §16.1.1 over the lens-sampling pdf, for a box pixel filter).
+    pub fn connect(&self, point: DVec3, aspect: f64, lens: DVec2) -> Option<FilmConnection> {
+        let b = &self.basis;
+        let lens_point = if self.has_lens() {
+            let disk = warp::square_to_concentric_disk(lens) * self.aperture_radius;
+            self.position + disk.x * b.right + disk.y * b.up
+        } else {
+            self.position
+        };
+        let towards_point = point - lens_point;
+        let depth = towards_point.dot(b.forward);
+        let distance = towards_point.length();
+        // Written so that NaN fails too.
+        let in_front = depth > self.near_clip.max(0.0) && distance > 0.0;
+        if !in_front {
+            return None;
+        }
+        // The ray from the lens point through `point` meets the focal plane
+        // (a pinhole: the unit plane) where `generate_ray` aims it.
+        let focus_depth = if self.has_lens() { self.focal_distance } else { 1.0 };
+        let direction = (lens_point + towards_point * (focus_depth / depth) - self.position) / focus_depth;
+        let x = direction.dot(b.right) / (b.tan_half_fov_y * aspect);
+        let y = direction.dot(b.up) / b.tan_half_fov_y;
+        let film = DVec2::new(0.5 * (x + 1.0), 0.5 * (1.0 - y));
+        let on_film = (0.0..1.0).contains(&film.x) && (0.0..1.0).contains(&film.y);
+        if !on_film {
+            return None;
+        }
+        let cos_theta = depth / distance;
+        let film_area = 4.0 * b.tan_half_fov_y * b.tan_half_fov_y * aspect;
+        // Camera rays start on the near-clip plane: only the part of the
+        // segment beyond it must be clear.
+        let clipped = self.near_clip.max(0.0) / cos_theta;
+        Some(FilmConnection {
+            film,
+            towards_lens: -towards_point / distance,
+            clear_distance: distance - clipped,
+            weight: 1.0 / (film_area * cos_theta * cos_theta * cos_theta * distance * distance),
+        })
+    }
+
     /// Depth of a world point along the view axis: what the focal distance
     /// must be for that point to be sharp.
     pub fn depth_of(&self, point: DVec3) -> f64 {
@@ -150,5 +222,72 @@ mod tests {
         camera.aperture_radius = 0.0;
         let pinhole = camera.generate_ray(film, 1.5, DVec2::new(0.1, 0.9));
         assert_eq!(pinhole.origin, DVec3::ZERO);
+    }
+
+    /// `connect` inverts `generate_ray`: a point on a camera ray maps back
+    /// to the film position and lens sample that made the ray, with the
+    /// direction back to the ray's start, through a pinhole and a lens,
+    /// with and without near clipping; points behind the lens or off the
+    /// film have no connection.
+    #[test]
+    fn connect_finds_the_film_point_of_a_camera_ray() {
+        let position = DVec3::new(1.0, 2.0, 3.0);
+        for (aperture, near_clip) in [(0.0, 0.0), (0.3, 0.0), (0.0, 0.5), (0.3, 0.5)] {
+            let mut camera = Camera::new(position, DVec3::new(0.0, 1.0, -4.0), DVec3::Y, 50.0, aperture, 5.0);
+            camera.near_clip = near_clip;
+            for (film, lens) in [
+                (DVec2::new(0.5, 0.5), DVec2::new(0.5, 0.5)),
+                (DVec2::new(0.1, 0.8), DVec2::new(0.2, 0.9)),
+                (DVec2::new(0.97, 0.03), DVec2::new(0.7, 0.1)),
+            ] {
+                let ray = camera.generate_ray(film, 1.6, lens);
+                let point = ray.at(3.0);
+                let connection = camera.connect(point, 1.6, lens).expect("a point on a camera ray is seen");
+                assert!((connection.film - film).length() < 1e-12, "{:?} vs {film:?}", connection.film);
+                assert!((connection.towards_lens + ray.direction).length() < 1e-12);
+                // The segment to clear ends where the camera ray started.
+                assert!(
+                    (connection.clear_distance - 3.0).abs() < 1e-12,
+                    "{}",
+                    connection.clear_distance
+                );
+                // Behind the lens: nothing.
+                assert!(camera.connect(ray.at(-3.0), 1.6, lens).is_none());
+            }
+            // Outside the field of view: nothing.
+            assert!(
+                camera
+                    .connect(position + 5.0 * camera.right(), 1.6, DVec2::splat(0.5))
+                    .is_none()
+            );
+        }
+    }
+
+    /// The weight is the Jacobian from film area to the point's area: the
+    /// film positions whose camera rays land on a small patch facing the
+    /// lens at distance d cover a fraction a of the film, and weight · A_patch
+    /// must equal that fraction (a pinhole, the patch off the axis).
+    #[test]
+    fn connection_weight_is_the_film_fraction_per_unit_area() {
+        let camera = Camera::new(DVec3::ZERO, DVec3::new(0.0, 0.0, -1.0), DVec3::Y, 60.0, 0.0, 1.0);
+        let aspect = 1.25;
+        let center = DVec3::new(1.0, 0.6, -4.0);
+        let towards_lens = -center.normalize();
+        let frame = crate::math::Frame::from_normal(towards_lens);
+        let half = 0.01;
+        // Film positions of the patch's corners: the patch is small enough
+        // that its image is a parallelogram to well below the tolerance.
+        let film_of = |u: f64, v: f64| {
+            let point = center + frame.to_world(DVec3::new(u, v, 0.0));
+            camera.connect(point, aspect, DVec2::ZERO).expect("in view").film
+        };
+        let (origin, du, dv) = (film_of(-half, -half), film_of(half, -half), film_of(-half, half));
+        let (a, b) = (du - origin, dv - origin);
+        let film_fraction = (a.x * b.y - a.y * b.x).abs();
+        let weight = camera.connect(center, aspect, DVec2::ZERO).expect("in view").weight;
+        let patch_area = (2.0 * half) * (2.0 * half);
+        // |cos θₓ| = 1: the patch faces the lens.
+        let relative = weight * patch_area / film_fraction - 1.0;
+        assert!(relative.abs() < 1e-3, "weight off by {relative}");
     }
 }

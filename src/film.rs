@@ -185,6 +185,50 @@ impl PixelAccumulator {
     }
 }
 
+/// Contributions of paths traced from the lights and splatted onto the film
+/// wherever they reach the lens (`integrator::path::caustic_paths`): per
+/// pixel, Σ contribution in the colour sums' fixed point, so the sums are
+/// exact and order-free like the camera samples'. Every pass traces
+/// `paths_per_pass` light paths, so a pixel with n camera samples (n
+/// passes) adds Σ / (`paths_per_pass` · n) to its estimate.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct LightSplats {
+    /// Light paths traced per pass, over the whole image.
+    pub paths_per_pass: u64,
+    /// Σ per channel and pixel (row-major), in units of 2⁻⁶⁴.
+    pub sums: Vec<[i128; 3]>,
+}
+
+impl LightSplats {
+    /// No splats yet, for `pixels` pixels.
+    pub fn new(paths_per_pass: u64, pixels: usize) -> Self {
+        Self {
+            paths_per_pass,
+            sums: vec![[0; 3]; pixels],
+        }
+    }
+
+    /// Adds a contribution to pixel `index` if [`accepts`] it; returns whether it did.
+    pub fn add(&mut self, index: usize, value: Color) -> bool {
+        if !accepts(value) {
+            return false;
+        }
+        for (sum, value) in self.sums[index].iter_mut().zip(value.to_array()) {
+            *sum = sum.wrapping_add(fixed_64(value));
+        }
+        true
+    }
+
+    /// What pixel `index` adds to the estimate after `passes` passes.
+    pub fn radiance(&self, index: usize, passes: u32) -> Color {
+        if passes == 0 || self.paths_per_pass == 0 {
+            return Color::ZERO;
+        }
+        let sum = Color::from_array(self.sums[index].map(|s| s as f64 / TWO_POW_64));
+        sum / (self.paths_per_pass as f64 * passes as f64)
+    }
+}
+
 /// The accumulated samples of a whole image (or of a farm part's share of
 /// it). Integrators add samples to it; [`Film::frame`] turns it into the
 /// linear image everything downstream reads.
@@ -200,6 +244,9 @@ pub struct Film {
     /// Samples that came back NaN, infinite or beyond [`MAX_SAMPLE_VALUE`]
     /// and were dropped.
     pub rejected_samples: u64,
+    /// Light-path contributions, for path tracing with caustics traced from
+    /// the lights; `None` for films of camera samples alone.
+    pub light: Option<LightSplats>,
 }
 
 /// Why two films cannot be added.
@@ -212,6 +259,10 @@ pub enum FilmMergeError {
     /// `u32::MAX`.
     #[error("pixel {0} would hold more than {max} samples", max = u32::MAX)]
     CountOverflow(usize),
+    /// One film has light-path contributions and the other not, or they
+    /// trace different numbers of light paths per pass.
+    #[error("the films were rendered with different light paths (caustic_light_paths)")]
+    LightPaths,
 }
 
 impl Film {
@@ -222,6 +273,7 @@ impl Film {
             height,
             pixels: vec![PixelAccumulator::default(); width as usize * height as usize],
             rejected_samples: 0,
+            light: None,
         }
     }
 
@@ -231,6 +283,20 @@ impl Film {
     pub fn merge(&mut self, other: &Film) -> Result<(), FilmMergeError> {
         if (self.width, self.height) != (other.width, other.height) {
             return Err(FilmMergeError::Size(self.width, self.height, other.width, other.height));
+        }
+        let empty = self.sample_count() == 0;
+        match (&mut self.light, &other.light) {
+            (None, None) => {}
+            (Some(light), Some(other)) if light.paths_per_pass == other.paths_per_pass => {
+                for (sums, other) in light.sums.iter_mut().zip(&other.sums) {
+                    for (sum, other) in sums.iter_mut().zip(other) {
+                        *sum = sum.wrapping_add(*other);
+                    }
+                }
+            }
+            // An empty film takes the other's light paths.
+            (None, Some(other)) if empty => self.light = Some(other.clone()),
+            _ => return Err(FilmMergeError::LightPaths),
         }
         for (index, (pixel, other)) in self.pixels.iter_mut().zip(&other.pixels).enumerate() {
             pixel.merge(other).ok_or(FilmMergeError::CountOverflow(index))?;
@@ -249,7 +315,12 @@ impl Film {
         Frame {
             width: self.width,
             height: self.height,
-            pixels: self.pixels.iter().map(|p| p.mean().as_vec3().to_array()).collect(),
+            pixels: match &self.light {
+                None => self.pixels.iter().map(|p| p.mean().as_vec3().to_array()).collect(),
+                Some(light) => (self.pixels.iter().enumerate())
+                    .map(|(i, p)| (p.mean() + light.radiance(i, p.count)).as_vec3().to_array())
+                    .collect(),
+            },
             noise: self.pixels.iter().map(|p| p.standard_error() as f32).collect(),
         }
     }

@@ -103,6 +103,11 @@ struct RenderArgs {
     /// (scenes with dispersive glass are spectral anyway).
     #[arg(long)]
     spectral: bool,
+    /// Path tracing: trace caustics (light focused by mirrors and glass onto
+    /// what the camera sees) from the lights and connect them to the lens
+    /// (`true`, the default), or leave them to camera paths (`false`).
+    #[arg(long, value_name = "true|false")]
+    caustic_light_paths: Option<bool>,
     /// SPPM: photons traced per iteration.
     #[arg(long)]
     photons: Option<u32>,
@@ -244,6 +249,7 @@ fn apply_overrides(settings: &mut RenderSettings, args: &RenderArgs) -> Result<(
         radius_schedule: args.radius_schedule,
         adaptive_threshold: args.adaptive_threshold,
         spectral: args.spectral.then_some(true),
+        caustic_light_paths: args.caustic_light_paths,
         time_seconds: args.time,
     };
     patch.apply_to(settings)?;

@@ -88,6 +88,11 @@ pub struct RenderSettings {
     /// transport, see `spectrum`); a scene with dispersive glass is rendered
     /// spectrally whatever this says.
     pub spectral: bool,
+    /// Path tracing: trace caustics (light focused by mirrors and glass onto
+    /// the surfaces the camera sees) from the lights and connect them to the
+    /// lens, rather than waiting for camera paths to hit the light through
+    /// the glass (`integrator::path::caustic_paths`).
+    pub caustic_light_paths: bool,
 }
 
 /// A rectangle of the image in film coordinates ([0, 1]², y down), so it
@@ -174,6 +179,7 @@ impl Default for RenderSettings {
             adaptive_threshold: None,
             region: None,
             spectral: false,
+            caustic_light_paths: true,
         }
     }
 }

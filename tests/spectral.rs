@@ -104,6 +104,9 @@ fn spectral_minus_rgb(loaded: &prism::scene::LoadedScene, runs: u64) -> [(f64, f
         height: 16,
         spp: 256,
         max_depth: 16,
+        // Light-traced caustics run in RGB only: without them both draw
+        // the same camera paths, which is what makes the pairs tell.
+        caustic_light_paths: Some(false),
         ..Job::default()
     };
     paired(loaded, job, runs, |spectral, rgb| spectral / rgb - 1.0)

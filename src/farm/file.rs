@@ -8,6 +8,7 @@
 //! | 4 | header length H, u32 (at most 16 MiB) |
 //! | H | header, UTF-8 TOML ([`FilmHeader`]) |
 //! | … | one record per pixel, row-major from the top-left |
+//! | … | if the header has `light_paths_per_pass`: one light record per pixel, in the same order |
 //! | 4 | CRC-32 (IEEE, as in gzip and PNG) of every byte before it |
 //!
 //! A record is five LEB128 variable-length integers: the sample count
@@ -15,7 +16,8 @@
 //! and the squared-luminance sum (u128, in units of 2⁻³²), exactly as the
 //! film keeps them (`crate::film::ExactSums`). A pixel no sample reached
 //! takes 5 bytes, one with a few samples about 20 (fixed-width records
-//! would take 68).
+//! would take 68). A light record is the three light-path sums
+//! (`crate::film::LightSplats`), zigzag-encoded like the colour sums.
 //! Uncovered rows are stored like any other, so every film file is a whole
 //! image and merging is adding records.
 //!
@@ -27,7 +29,7 @@
 
 use super::FarmError;
 use super::header::FilmHeader;
-use crate::film::{ExactSums, Film, PixelAccumulator};
+use crate::film::{ExactSums, Film, LightSplats, PixelAccumulator};
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -140,6 +142,7 @@ fn write_to(path: &Path, header: &FilmHeader, film: &Film) -> Result<(), String>
     }
     let header = FilmHeader {
         rejected_samples: film.rejected_samples,
+        light_paths_per_pass: film.light.as_ref().map(|light| light.paths_per_pass),
         ..header.clone()
     }
     .to_toml()?;
@@ -159,6 +162,11 @@ fn write_to(path: &Path, header: &FilmHeader, film: &Film) -> Result<(), String>
         encode_record(&pixel.exact_sums(), &mut record);
         out.write_all(&record).map_err(io)?;
     }
+    for sums in film.light.iter().flat_map(|light| &light.sums) {
+        record.clear();
+        encode_light_record(sums, &mut record);
+        out.write_all(&record).map_err(io)?;
+    }
     let crc = out.crc.clone().finalize();
     let mut inner = out.inner;
     inner.write_all(&crc.to_le_bytes()).map_err(io)?;
@@ -169,11 +177,16 @@ fn write_to(path: &Path, header: &FilmHeader, film: &Film) -> Result<(), String>
 
 fn encode_record(sums: &ExactSums, out: &mut Vec<u8>) {
     write_varint(sums.count as u128, out);
-    for sum in sums.sum {
-        // Zigzag: small magnitudes of either sign take few bytes.
+    encode_light_record(&sums.sum, out);
+    write_varint(sums.luminance_squared_sum, out);
+}
+
+/// Three colour sums, zigzag-encoded: small magnitudes of either sign take
+/// few bytes. Also a pixel's light record.
+fn encode_light_record(sums: &[i128; 3], out: &mut Vec<u8>) {
+    for sum in sums {
         write_varint(((sum << 1) ^ (sum >> 127)) as u128, out);
     }
-    write_varint(sums.luminance_squared_sum, out);
 }
 
 fn write_varint(mut value: u128, out: &mut Vec<u8>) {
@@ -263,11 +276,44 @@ pub fn add_film_file(path: &Path, film: &mut Film) -> Result<FilmHeader, FarmErr
             overflow = Some(index);
         }
     });
-    match checked {
-        Ok(used) if used == records.len() => {}
-        Ok(_) => return Err(corrupt(path, "bytes after the last pixel")),
+    let light_start = match checked {
+        Ok(used) => used,
         Err(Decode::Short(read)) => return Err(truncated(path, &format!("it ends after {read} of {pixels} pixels"))),
         Err(Decode::Invalid(index)) => return Err(corrupt(path, &format!("pixel {index} is not a valid record"))),
+    };
+    let light = match header.light_paths_per_pass {
+        None if light_start == records.len() => None,
+        None => return Err(corrupt(path, "bytes after the last pixel")),
+        Some(paths_per_pass) => {
+            let mut light = LightSplats::new(paths_per_pass, pixels);
+            match decode_light_records(&records[light_start..], &mut light.sums) {
+                Ok(used) if light_start + used == records.len() => Some(light),
+                Ok(_) => return Err(corrupt(path, "bytes after the last light record")),
+                Err(Decode::Short(read)) => {
+                    return Err(truncated(path, &format!("it ends after {read} of {pixels} light records")));
+                }
+                Err(Decode::Invalid(index)) => {
+                    return Err(corrupt(path, &format!("light record {index} is not a valid record")));
+                }
+            }
+        }
+    };
+    // Light paths must be alike in every part (an empty film takes the file's).
+    let empty = film.sample_count() == 0;
+    match (&film.light, &light) {
+        (None, None) => {}
+        (Some(a), Some(b)) if a.paths_per_pass == b.paths_per_pass => {}
+        (None, Some(_)) if empty => {}
+        _ => {
+            let describe = |light: Option<u64>| light.map_or("none".to_string(), |n| format!("{n} per pass"));
+            return Err(FarmError::OtherImage {
+                path: path.to_path_buf(),
+                other: PathBuf::from("the parts before it"),
+                key: "light paths".into(),
+                value: describe(film.light.as_ref().map(|l| l.paths_per_pass)),
+                other_value: describe(header.light_paths_per_pass),
+            });
+        }
     }
     if let Some(index) = overflow {
         return Err(FarmError::io(
@@ -279,6 +325,16 @@ pub fn add_film_file(path: &Path, film: &mut Film) -> Result<FilmHeader, FarmErr
         // Checked above: the counts fit.
         let _ = film.pixels[index].merge(&PixelAccumulator::from_exact_sums(sums));
     });
+    match (&mut film.light, light) {
+        (Some(sums), Some(light)) => {
+            for (sums, light) in sums.sums.iter_mut().zip(light.sums) {
+                for (sum, add) in sums.iter_mut().zip(light) {
+                    *sum = sum.wrapping_add(add);
+                }
+            }
+        }
+        (film_light, light) => *film_light = light.or(film_light.take()),
+    }
     film.rejected_samples = film.rejected_samples.saturating_add(header.rejected_samples);
     Ok(header)
 }
@@ -367,6 +423,22 @@ fn decode_records(bytes: &[u8], pixels: usize, mut each: impl FnMut(usize, Exact
             ),
             Err(VarintError::End) => return Err(Decode::Short(index)),
             Err(VarintError::TooLong) => return Err(Decode::Invalid(index)),
+        }
+    }
+    Ok(at)
+}
+
+/// Decodes one light record per entry of `sums` from `bytes` into it;
+/// returns the bytes used.
+fn decode_light_records(bytes: &[u8], sums: &mut [[i128; 3]]) -> Result<usize, Decode> {
+    let mut at = 0;
+    for (index, pixel) in sums.iter_mut().enumerate() {
+        for sum in pixel.iter_mut() {
+            let zigzag = read_varint(bytes, &mut at, 128).map_err(|e| match e {
+                VarintError::End => Decode::Short(index),
+                VarintError::TooLong => Decode::Invalid(index),
+            })?;
+            *sum = ((zigzag >> 1) as i128) ^ -((zigzag & 1) as i128);
         }
     }
     Ok(at)

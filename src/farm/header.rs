@@ -33,6 +33,11 @@ pub struct FilmHeader {
     pub target_samples: Option<u32>,
     /// Samples dropped as NaN, infinite or too large, over all pixels.
     pub rejected_samples: u64,
+    /// Light paths traced per pass, when the film holds light-path
+    /// contributions (path tracing with `caustic_light_paths`): the records
+    /// are then followed by one light record per pixel.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub light_paths_per_pass: Option<u64>,
     /// What must agree between parts of one image (see the module doc).
     pub image: BTreeMap<String, String>,
     /// The samples held: blocks of rows, each with a range of sample indices.
@@ -104,6 +109,9 @@ pub fn image_identity(settings: &RenderSettings, scene_hash: &str) -> BTreeMap<S
         // Only when set, so RGB films keep the headers they always had.
         put("spectral", "true".to_string());
     }
+    if settings.caustic_light_paths && settings.integrator == IntegratorKind::PathTracing {
+        put("caustic_light_paths", "true".to_string());
+    }
     match settings.integrator {
         IntegratorKind::PathTracing | IntegratorKind::BsdfOnly => {
             let threshold = settings.adaptive_threshold.map_or("off".into(), |t| format!("{t:?}"));
@@ -132,6 +140,7 @@ impl FilmHeader {
             height: settings.height,
             target_samples: target,
             rejected_samples: 0,
+            light_paths_per_pass: None,
             image: image_identity(settings, scene_hash),
             coverage: vec![CoverageBlock::of_share(share)],
         }

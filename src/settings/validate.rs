@@ -84,6 +84,9 @@ pub enum Setting {
     AdaptiveThreshold,
     /// Spectral transport (true) or RGB (false, the default).
     Spectral,
+    /// Path tracing: caustics traced from the lights (true, the default) or
+    /// by camera paths alone (false).
+    CausticLightPaths,
     /// Worker threads, 1 to [`MAX_THREADS`] (command line only).
     Threads,
     /// Exposure in stops, within ±[`MAX_EXPOSURE_STOPS`] (command line only;
@@ -108,6 +111,7 @@ impl Setting {
             Setting::RadiusSchedule => "radius_schedule",
             Setting::AdaptiveThreshold => "adaptive_threshold",
             Setting::Spectral => "spectral",
+            Setting::CausticLightPaths => "caustic_light_paths",
             Setting::TimeLimit | Setting::Threads | Setting::Exposure => return None,
         })
     }
@@ -129,6 +133,7 @@ impl Setting {
             Setting::RadiusSchedule => "--radius-schedule",
             Setting::AdaptiveThreshold => "--adaptive-threshold",
             Setting::Spectral => "--spectral",
+            Setting::CausticLightPaths => "--caustic-light-paths",
             Setting::Threads => "--threads",
             Setting::Exposure => "--exposure",
         }
@@ -194,6 +199,8 @@ pub struct SettingsPatch {
     pub adaptive_threshold: Option<f64>,
     /// Spectral transport (`--spectral`).
     pub spectral: Option<bool>,
+    /// Caustics traced from the lights (`--caustic-light-paths`).
+    pub caustic_light_paths: Option<bool>,
     /// Command line only: render for this long instead of to a sample count.
     #[serde(skip)]
     pub time_seconds: Option<f64>,
@@ -263,6 +270,7 @@ impl SettingsPatch {
             next.adaptive_threshold = Some(threshold);
         }
         next.spectral = self.spectral.unwrap_or(next.spectral);
+        next.caustic_light_paths = self.caustic_light_paths.unwrap_or(next.caustic_light_paths);
         *settings = next;
         Ok(())
     }

@@ -33,6 +33,8 @@ pub struct Job {
     pub threads: Option<usize>,
     /// Spectral transport (the scene's own setting also turns it on).
     pub spectral: bool,
+    /// Light-traced caustics on or off; `None`: the scene's setting.
+    pub caustic_light_paths: Option<bool>,
 }
 
 impl Default for Job {
@@ -47,6 +49,7 @@ impl Default for Job {
             max_depth: 64,
             threads: None,
             spectral: false,
+            caustic_light_paths: None,
         }
     }
 }
@@ -62,6 +65,7 @@ pub fn render(loaded: &LoadedScene, job: &Job) -> Frame {
         sampler: job.sampler,
         seed: job.seed,
         spectral: job.spectral || loaded.settings.spectral,
+        caustic_light_paths: job.caustic_light_paths.unwrap_or(loaded.settings.caustic_light_paths),
         ..loaded.settings.clone()
     };
     match render_with_threads(&loaded.scene, &loaded.camera, &settings, job.threads) {

@@ -4,17 +4,18 @@
 //! sample index A + k, so a share's film is exactly its samples of the
 //! whole render.
 
+pub mod caustic_paths;
 pub mod tracer;
 
 pub use tracer::PathTracer;
 
 use super::{Integrator, RowSet, Share, pass};
 use crate::camera::Camera;
-use crate::film::{Film, Frame};
+use crate::film::{Film, Frame, LightSplats};
 use crate::math::Ray;
 use crate::sampler::{Sampler, SamplerKind};
 use crate::scene::Scene;
-use crate::settings::RenderSettings;
+use crate::settings::{IntegratorKind, RenderSettings};
 use glam::DVec2;
 use rayon::prelude::*;
 use std::sync::atomic::AtomicBool;
@@ -34,6 +35,21 @@ pub struct PathIntegrator {
     adaptive_threshold: Option<f64>,
     /// Every pixel has met the adaptive threshold (see `Integrator::converged`).
     converged: bool,
+    /// Whether the settings ask for caustics traced from the lights and
+    /// nothing rules them out (see [`caustic_paths_apply`]); the scene then
+    /// decides whether they run.
+    caustic_paths: bool,
+}
+
+/// Whether `settings` allow light-traced caustics: asked for, path tracing
+/// with light sampling, RGB, and every pixel sampled every pass (a pixel's
+/// light-path estimate is divided by its pass count, which adaptive
+/// sampling would make differ from its sample count).
+fn caustic_paths_apply(settings: &RenderSettings) -> bool {
+    settings.caustic_light_paths
+        && settings.integrator == IntegratorKind::PathTracing
+        && !settings.spectral
+        && settings.adaptive_threshold.is_none()
 }
 
 impl PathIntegrator {
@@ -55,6 +71,7 @@ impl PathIntegrator {
             rows: share.rows,
             adaptive_threshold: settings.adaptive_threshold,
             converged: false,
+            caustic_paths: caustic_paths_apply(settings),
         }
     }
 }
@@ -96,8 +113,29 @@ pub fn camera_ray(camera: &Camera, (width, height): (u32, u32), x: u32, y: u32, 
 
 impl Integrator for PathIntegrator {
     fn render_pass(&mut self, scene: &Scene, camera: &Camera, cancel: &AtomicBool) -> bool {
+        let spectral = self.settings.spectral || scene.has_dispersion();
+        let light_traced = self.caustic_paths && !spectral && caustic_paths::scene_has_caustics(scene);
+        self.tracer.caustics_by_light_paths = light_traced;
+        if light_traced {
+            let pixels = self.settings.sampled_pixels();
+            let film = &mut self.film;
+            if film.light.is_none() && film.sample_count() == 0 {
+                film.light = Some(LightSplats::new(
+                    caustic_paths::paths_per_pass(pixels.pixel_count()),
+                    film.pixels.len(),
+                ));
+            }
+            let stream = (self.sampler, self.seed, self.first_sample + self.passes);
+            // Only this share's rows keep splats: every share traces the
+            // light paths of its passes, and each pixel divides by its own.
+            let rows = self.rows;
+            let share_pixels = |x: u32, y: u32| pixels.contains(x, y) && rows.contains(y);
+            if !caustic_paths::add_pass(film, scene, camera, share_pixels, self.settings.max_depth, stream, cancel) {
+                return false;
+            }
+        }
         // RGB or spectral, chosen once per pass: each is its own compiled loop.
-        let completed = if self.settings.spectral || scene.has_dispersion() {
+        let completed = if spectral {
             self.add_pass(scene, camera, cancel, PathTracer::spectral_radiance)
         } else {
             self.add_pass(scene, camera, cancel, PathTracer::radiance)

@@ -5,6 +5,7 @@
 //!
 //! This file is the per-sample tracer; [`super`] drives it over the film.
 
+use super::caustic_paths::traces_caustics;
 use crate::color::Color;
 use crate::material::{ShadingPoint, Transport};
 use crate::math::{Frame as ShadingFrame, Ray, warp::power_heuristic};
@@ -25,6 +26,10 @@ pub struct PathTracer {
     pub max_depth: u32,
     /// Sample lights directly and weight by MIS (false: BSDF sampling only).
     pub light_sampling: bool,
+    /// Leave caustics seen on the first surface to light paths: drop the
+    /// emission of a shape light reached through a specular surface after
+    /// a non-specular first surface (see [`super::caustic_paths`]).
+    pub caustics_by_light_paths: bool,
 }
 
 impl PathTracer {
@@ -34,6 +39,7 @@ impl PathTracer {
         Self {
             max_depth: settings.max_depth,
             light_sampling: settings.integrator != IntegratorKind::BsdfOnly,
+            caustics_by_light_paths: false,
         }
     }
 
@@ -68,6 +74,9 @@ impl PathTracer {
         let mut previous_pdf = 0.0;
         let mut previous_point = ray.origin;
         let light_sampling = self.light_sampling && !scene.lights.is_empty();
+        // The first surface is not specular: a light then reached through a
+        // specular bounce is a caustic that light paths bring in.
+        let mut first_surface_not_specular = false;
 
         for bounce in 0.. {
             let Some(intersection) = scene.intersect(&ray, f64::INFINITY) else {
@@ -81,6 +90,14 @@ impl PathTracer {
             // Emission found by the BSDF sample, weighted against light sampling.
             if let Some(emitted) = material.emission_towards(hit.geometric_normal.dot(wo_world)) {
                 let weight = match scene.lights.light_of_primitive(intersection.primitive) {
+                    Some(light)
+                        if self.caustics_by_light_paths
+                            && specular_bounce
+                            && first_surface_not_specular
+                            && traces_caustics(&scene.lights.lights[light as usize]) =>
+                    {
+                        0.0
+                    }
                     Some(light) if light_sampling && !specular_bounce => {
                         let light_pdf = scene
                             .lights
@@ -93,6 +110,9 @@ impl PathTracer {
             }
             if !material.scatters() || bounce >= self.max_depth {
                 break;
+            }
+            if bounce == 0 {
+                first_surface_not_specular = !material.is_specular();
             }
 
             let frame = ShadingFrame::from_normal(hit.shading_normal);
