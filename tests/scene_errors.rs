@@ -372,7 +372,7 @@ fn render_settings_in_the_file_are_checked_like_the_flags() {
         10,
         9,
         "render.width",
-        "needs about 432.0 GB of memory",
+        "needs about 720.0 GB of memory",
     );
 }
 

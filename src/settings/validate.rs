@@ -44,6 +44,12 @@ pub const RADIUS_RANGE: (f64, f64) = (1e-12, 1e12);
 /// its copy for the encoder (6), and room for the EXR encoder's f32 copy (12),
 /// rounded up.
 pub const PATH_TRACING_BYTES_PER_PIXEL: u64 = 120;
+
+/// Bytes per pixel that light-traced caustics add to path tracing: the
+/// film's fixed-point light sums (48) and one pass's list of connections
+/// before they are summed (32 per connection; a light path per four pixels
+/// connects at most about eight times on the shipped scenes), rounded up.
+pub const LIGHT_PATH_BYTES_PER_PIXEL: u64 = 80;
 /// Bytes of memory per pixel that SPPM needs: its pixel statistics (64) and
 /// photon tallies (32), one pass's visible points (about 250) with their grid
 /// keys (a sphere covers up to 8 cells: 8 × 12 bytes, plus the point list of
@@ -334,6 +340,7 @@ impl RenderSettings {
     pub fn memory_estimate(&self) -> u64 {
         let per_pixel = match self.integrator {
             IntegratorKind::Sppm => SPPM_BYTES_PER_PIXEL,
+            IntegratorKind::PathTracing if self.caustic_light_paths => PATH_TRACING_BYTES_PER_PIXEL + LIGHT_PATH_BYTES_PER_PIXEL,
             IntegratorKind::PathTracing | IntegratorKind::BsdfOnly => PATH_TRACING_BYTES_PER_PIXEL,
         };
         self.width as u64 * self.height as u64 * per_pixel
@@ -427,8 +434,15 @@ mod tests {
         let settings = RenderSettings {
             width: 15_000,
             height: 15_000,
+            caustic_light_paths: false,
             ..Default::default()
         };
+        // With light-traced caustics, 2.25e8 pixels × 200 bytes = 45 GB.
+        let traced = RenderSettings {
+            caustic_light_paths: true,
+            ..settings.clone()
+        };
+        assert_eq!(traced.memory_estimate(), 45_000_000_000);
         // 2.25e8 pixels × 120 bytes = 27 GB.
         assert_eq!(settings.memory_estimate(), 27_000_000_000);
         let error = settings.check_memory(Some(8_000_000_000)).err().map(|e| e.message);

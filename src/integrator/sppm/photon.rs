@@ -23,7 +23,7 @@
 use super::visible_point::bsdf_inputs;
 use crate::color::{Color, luminance};
 use crate::geometry::SurfaceHit;
-use crate::light::{EmitterSource, Light};
+use crate::light::EmitterSource;
 use crate::material::{ShadingPoint, Transport};
 use crate::math::{DVec3, Frame as ShadingFrame, Ray, warp};
 use crate::sampler::Sampler;
@@ -111,20 +111,6 @@ impl PhotonSources {
         let u_shape = ((u_select - p_sky) / (1.0 - p_sky)).min(1.0 - f64::EPSILON / 2.0);
         emit_from_shape(scene, u_shape, 1.0 - p_sky, sampler, wavelengths)
     }
-}
-
-/// Draws one photon from the emissive shapes alone (never the sky), a shape
-/// chosen in proportion to its power among all of them; `None` if no shape
-/// emits or the one chosen is not `accept`ed (so the photons of the
-/// accepted lights are exactly those they would be with every light).
-pub fn emit_from_shapes<C: Radiance>(scene: &Scene, sampler: &mut Sampler, accept: impl Fn(&Light) -> bool) -> Option<Photon<C>> {
-    let wavelengths = C::sample_wavelengths(sampler);
-    let u_select = sampler.next_1d();
-    let (index, _) = scene.lights.choose(u_select)?;
-    if !accept(&scene.lights.lights[index as usize]) {
-        return None;
-    }
-    emit_from_shape(scene, u_select, 1.0, sampler, wavelengths)
 }
 
 /// A photon from the emissive shapes, chosen by `u_select`, which is itself
