@@ -345,8 +345,12 @@ class Mitsuba:
         return f"Mitsuba {self.mi.__version__} ({self.variant}), Dr.Jit {self.dr.__version__}"
 
 
+PRISM_EXTRA_ARGS = []
+
+
 def prism_render(prism, scene_path, out, threads, seed, spp=None, seconds=None, width=None, height=None):
     command = [prism, "render", str(scene_path), "-o", str(out), "--threads", str(threads), "--seed", str(seed), "--quiet"]
+    command += PRISM_EXTRA_ARGS
     command += ["--spp", str(spp)] if spp else ["--time", str(seconds)]
     if width:
         command += ["--width", str(width)]
@@ -523,7 +527,10 @@ def main():
     parser.add_argument("--rr-depth", type=int, default=5, help="Mitsuba's Russian roulette depth (its default: 5)")
     parser.add_argument("--keep-images", help="save the equal-time images here as .npy")
     parser.add_argument("--skip-paths", action="store_true", help="skip the paths-per-second runs")
+    parser.add_argument("--prism-args", default="",
+                        help="extra flags for every prism render, e.g. '--caustic-light-paths false'")
     args = parser.parse_args()
+    PRISM_EXTRA_ARGS.extend(args.prism_args.split())
     args.threads = [int(t) for t in args.threads.split(",") if t]
     args.times = [float(t) for t in args.times.split(",") if t]
     args.configurations = [c for c in args.configurations.split(",") if c]
@@ -547,7 +554,7 @@ def main():
     output = Path(args.output_dir)
     comments = [
         f"benches/peers/mitsuba_cornell.py: {mitsuba.version()}, path integrator (max_depth = Prism's + 1, rr_depth {args.rr_depth}), "
-        f"sampler {args.sampler}; Prism {args.prism} (pt, sobol)",
+        f"sampler {args.sampler}; Prism {args.prism} (pt, sobol{', ' + args.prism_args if args.prism_args else ''})",
         machine_note(),
     ]
     if path_rows:

@@ -161,6 +161,14 @@ fn ui_render(app: &mut ViewerApp, ui: &mut Ui) {
         ui.checkbox(&mut app.settings.spectral, "Spectral")
             .on_hover_text("Carry 4 sampled wavelengths per path and photon instead of RGB (path tracing and SPPM)");
     }
+    if app.settings.integrator == IntegratorKind::PathTracing {
+        ui.checkbox(&mut app.settings.caustic_light_paths, "Caustics from the lights")
+            .on_hover_text(
+                "Trace the light that mirrors and glass focus onto what the camera sees from the lights, \
+                 and connect it to the lens: the same image, far less noise in caustics \
+                 (RGB, without adaptive sampling)",
+            );
+    }
 
     let sppm = app.settings.integrator == IntegratorKind::Sppm;
     let mut unlimited = app.settings.samples_per_pixel.is_none();
