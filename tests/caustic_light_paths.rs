@@ -225,3 +225,25 @@ fn farm_parts_with_light_traced_caustics_merge_into_the_single_process_image() {
     assert!(stderr.contains("caustic_light_paths"), "{stderr}");
     let _ = std::fs::remove_dir_all(&folder);
 }
+
+/// Where light paths can find nothing, nothing changes: smallpt's only
+/// light is a sphere cut by the ceiling (left to camera paths), and the
+/// bunny scene has no mirror or glass; both render the same bits either way.
+#[test]
+fn scenes_without_caustics_to_trace_are_unchanged() {
+    for name in ["smallpt.toml", "bunny.toml"] {
+        let loaded = common::shipped_scene(name);
+        let job = |caustic_light_paths| Job {
+            width: 24,
+            height: 18,
+            spp: 2,
+            caustic_light_paths: Some(caustic_light_paths),
+            ..Job::default()
+        };
+        assert_eq!(
+            render(&loaded, &job(true)).pixels,
+            render(&loaded, &job(false)).pixels,
+            "{name}"
+        );
+    }
+}
