@@ -398,3 +398,19 @@ fn a_scene_opens_through_the_path_field() {
     });
     assert_eq!(harness.state().scene_error(), None);
 }
+
+/// The "Caustics from the lights" box turns the light paths off (they are
+/// on by default) and restarts the render with that setting.
+#[test]
+fn the_caustics_box_switches_light_paths_and_restarts() {
+    let mut harness = start(None);
+    step_until(&mut harness, "a first pass", |app| app.render_stats().passes >= 1);
+    assert!(harness.state().settings().caustic_light_paths, "on by default");
+    let before = harness.state().render_stats().generation;
+    harness.get_by_label("Caustics from the lights").click();
+    step_until(&mut harness, "the restart", |app| app.render_stats().generation > before);
+    assert!(!harness.state().settings().caustic_light_paths);
+    harness.get_by_label("Caustics from the lights").click();
+    harness.step();
+    assert!(harness.state().settings().caustic_light_paths);
+}
