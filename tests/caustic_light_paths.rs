@@ -226,12 +226,11 @@ fn farm_parts_with_light_traced_caustics_merge_into_the_single_process_image() {
     let _ = std::fs::remove_dir_all(&folder);
 }
 
-/// Where light paths can find nothing, nothing changes: smallpt's only
-/// light is a sphere cut by the ceiling (left to camera paths), and the
-/// bunny scene has no mirror or glass; both render the same bits either way.
+/// Where light paths can find nothing, nothing changes: the bunny and the
+/// earth scenes have no mirror or glass, and render the same bits either way.
 #[test]
 fn scenes_without_caustics_to_trace_are_unchanged() {
-    for name in ["smallpt.toml", "bunny.toml"] {
+    for name in ["earth.toml", "bunny.toml"] {
         let loaded = common::shipped_scene(name);
         let job = |caustic_light_paths| Job {
             width: 24,

@@ -326,6 +326,18 @@ impl Scene {
         }
     }
 
+    /// The sphere itself if a primitive is one (centre, radius); `None` for
+    /// every other kind.
+    pub fn primitive_sphere(&self, primitive: u32) -> Option<(glam::DVec3, f64)> {
+        match self.triangle_index(primitive) {
+            Some(_) => None,
+            None => match &self.shapes[primitive as usize].shape {
+                Shape::Sphere(sphere) => Some((sphere.center, sphere.radius)),
+                _ => None,
+            },
+        }
+    }
+
     /// Which mesh face (and material) a triangle primitive is; `None` for shapes.
     pub fn triangle_source(&self, primitive: u32) -> Option<TriangleSource> {
         self.triangle_index(primitive).map(|triangle| self.triangles.source(triangle))

@@ -126,6 +126,33 @@ impl ClippedSphere {
         (smallest.1 < self.sphere.sampled_area_from(reference)).then_some(smallest)
     }
 
+    /// The smallest cap of the emitter that every point of the ball
+    /// (`center`, `radius`) might see, with its area: a straight segment
+    /// from the ball to the emitter crosses no clipping sphere, so it ends
+    /// on the ball's side of each, and the smallest of those caps holds
+    /// every such end. `None` if the ball straddles a clipping sphere's
+    /// surface (points of it see either side); then only the whole sphere
+    /// is sure to hold them.
+    pub fn cap_seen_by_ball(&self, center: DVec3, radius: f64) -> Option<(SphereCap, f64)> {
+        let mut smallest: Option<(SphereCap, f64)> = None;
+        for clip in &self.clips {
+            let distance = (center - clip.center).length();
+            // A margin far beyond rounding, as for reference points.
+            let band = SURFACE_BAND * (clip.size + center.abs().max_element() + radius);
+            let side = if distance + radius < clip.radius - band {
+                (clip.inside, clip.inside_area)
+            } else if distance - radius > clip.radius + band {
+                (clip.outside, clip.outside_area)
+            } else {
+                return None;
+            };
+            if smallest.is_none_or(|(_, area)| side.1 < area) {
+                smallest = Some(side);
+            }
+        }
+        smallest
+    }
+
     /// Whether the point with unit normal `normal` lies in every cap
     /// visible from `reference` (else a clipping sphere hides it).
     #[inline]

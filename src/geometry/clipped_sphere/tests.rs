@@ -302,3 +302,24 @@ fn sweep_finds_every_crossing_pair() {
     }
     assert!(swept.iter().filter(|c| c.is_some()).count() > 10, "the test needs crossings");
 }
+
+/// A ball inside the room sees only the sliver of smallpt's light below the
+/// ceiling (its smallest cap, which holds every light point a segment from
+/// the ball can reach); a ball that pokes through a wall could see either
+/// side of it, so no cap is sure to hold what it sees.
+#[test]
+fn a_ball_in_the_room_sees_the_light_below_the_ceiling_only() {
+    let (light, walls) = smallpt();
+    let clipped = ClippedSphere::new(light, walls).expect("the walls cut the light");
+    let (cap, area) = clipped
+        .cap_seen_by_ball(DVec3::new(73.0, 16.5, 78.0), 16.5)
+        .expect("the glass ball is inside every wall");
+    // The sliver about 0.27 deep: 2π R h (the ceiling's own curvature,
+    // radius 10⁵, changes h by under 1% over the sliver's 18-unit radius).
+    let depth: f64 = 81.6 - (681.33 - 600.0);
+    let sliver = 2.0 * std::f64::consts::PI * 600.0 * depth;
+    assert!((area / sliver - 1.0).abs() < 0.02, "{area} vs {sliver}");
+    assert!(cap.contains(-DVec3::Y) && !cap.contains(DVec3::Y));
+    // A ball through the left wall (x = 1).
+    assert!(clipped.cap_seen_by_ball(DVec3::new(0.5, 16.5, 78.0), 16.5).is_none());
+}

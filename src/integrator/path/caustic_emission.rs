@@ -6,14 +6,21 @@
 //! on the Cornell box, whose glass ball fills a small part of the light's
 //! sky. Instead, each specular object is bounded by a sphere (a caster),
 //! and the photon's direction is drawn uniformly in the cone one caster
-//! subtends from the point on the light, a caster chosen uniformly. Every
+//! subtends from the point on the light, a caster chosen uniformly. (The
+//! point is uniform on the light, or, on a sphere light cut by opaque
+//! spheres such as smallpt's, of which only a sliver shows in the room,
+//! uniform on the cap that the caster might see.) Every
 //! direction towards a specular surface lies in some caster's cone, so the
 //! density below is positive wherever the integrand is not zero; where the
 //! cones overlap it is their mixture (the one-sample balance heuristic of
 //! Veach 1997 §9.2.4), so the flux Le · |cos θ| / (p_light · p_area · p(ω))
-//! is an unbiased weight for every path light tracing takes.
+//! is an unbiased weight for every path light tracing takes, p_area and
+//! p(ω) being the mixture over casters of the point's and the direction's
+//! densities.
 
 use crate::color::Color;
+use crate::geometry::clipped_sphere::SphereCap;
+use crate::geometry::{AreaSample, ClippedSphere};
 use crate::light::{EmitterSource, Light};
 use crate::math::{Aabb, DVec3, Frame, Ray, warp};
 use crate::sampler::Sampler;
@@ -54,6 +61,15 @@ impl Caster {
         Some((cos_theta_max, offset / distance_squared.sqrt()))
     }
 
+    /// Where on `light` photons aimed at this caster start: for a sphere
+    /// cut by opaque spheres, the cap every point of the caster might see
+    /// (with the clipped sphere and the cap's area); `None`: anywhere on it.
+    fn region_of<'a>(&self, light: &'a Light) -> Option<(&'a ClippedSphere, SphereCap, f64)> {
+        let clipped = light.clipped.as_deref()?;
+        let (cap, area) = clipped.cap_seen_by_ball(self.center, self.radius)?;
+        Some((clipped, cap, area))
+    }
+
     /// The density of a direction drawn towards this caster from `point`.
     fn pdf(&self, point: DVec3, direction: DVec3) -> f64 {
         match self.cone_from(point) {
@@ -76,9 +92,20 @@ impl CausticEmission {
     /// more than [`MAX_CASTERS`].
     pub fn new(scene: &Scene) -> Self {
         let mut shapes = Vec::new();
+        let mut spheres = Vec::new();
         let mut meshes: BTreeMap<(u32, u32), Aabb> = BTreeMap::new();
         for primitive in 0..scene.primitive_count() as u32 {
             if !scene.material_of(primitive).is_specular() {
+                continue;
+            }
+            // A sphere bounds itself exactly: a box's sphere would reach √3
+            // times as far, through the walls a ball stands beside (and into
+            // the clipping spheres of a clipped light, see `region_of`).
+            if let Some((center, radius)) = scene.primitive_sphere(primitive) {
+                spheres.push(Caster {
+                    center,
+                    radius: radius * (1.0 + 1e-9),
+                });
                 continue;
             }
             let bounds = scene.primitive_bounds(primitive);
@@ -90,14 +117,20 @@ impl CausticEmission {
                 None => shapes.push(bounds),
             }
         }
-        let mut all: Vec<Aabb> = shapes.into_iter().chain(meshes.into_values()).collect();
-        all.retain(|b| !b.is_empty() && b.extent().is_finite());
-        if all.len() > MAX_CASTERS {
-            all = vec![all.iter().fold(Aabb::default(), |union, b| union.union(*b))];
+        let mut boxes: Vec<Aabb> = shapes.into_iter().chain(meshes.into_values()).collect();
+        boxes.retain(|b| !b.is_empty() && b.extent().is_finite());
+        spheres.retain(|s| s.center.is_finite() && s.radius.is_finite());
+        let mut casters: Vec<Caster> = spheres.into_iter().chain(boxes.iter().map(|b| Caster::around(*b))).collect();
+        if casters.len() > MAX_CASTERS {
+            let union = casters.iter().fold(Aabb::default(), |union, c| {
+                union.union(Aabb {
+                    min: c.center - DVec3::splat(c.radius),
+                    max: c.center + DVec3::splat(c.radius),
+                })
+            });
+            casters = vec![Caster::around(union)];
         }
-        Self {
-            casters: all.into_iter().map(Caster::around).collect(),
-        }
+        Self { casters }
     }
 
     /// Whether the scene has specular surfaces to aim at.
@@ -105,22 +138,32 @@ impl CausticEmission {
         self.casters.is_empty()
     }
 
-    /// Draws a photon from a light that `accept`s, aimed at a caster: its
-    /// ray and flux (see the module doc); `None` if no light emits, the
-    /// light chosen is not accepted, or it does not emit that way.
-    pub fn emit(&self, scene: &Scene, sampler: &mut Sampler, accept: impl Fn(&Light) -> bool) -> Option<(Ray, Color)> {
+    /// Draws a photon aimed at a caster: its ray and flux (see the module
+    /// doc); `None` if no light emits or the one chosen does not emit that way.
+    pub fn emit(&self, scene: &Scene, sampler: &mut Sampler) -> Option<(Ray, Color)> {
         let u_select = sampler.next_1d();
         let u_area = sampler.next_2d();
         let u_caster = sampler.next_1d();
         let u_direction = sampler.next_2d();
         let (index, select_probability) = scene.lights.choose(u_select)?;
         let light = &scene.lights.lights[index as usize];
-        if !accept(light) || self.casters.is_empty() {
+        if self.casters.is_empty() {
             return None;
         }
         let emitter = scene.emitter(light.primitive);
-        let on_light = emitter.sample_area(u_area);
         let caster = self.casters[((u_caster * self.casters.len() as f64) as usize).min(self.casters.len() - 1)];
+        let on_light = match caster.region_of(light) {
+            Some((sphere, cap, _)) => {
+                let normal = cap.sample_normal(u_area);
+                let (point, point_error) = sphere.sphere.point_with_normal(normal);
+                AreaSample {
+                    point,
+                    point_error,
+                    normal,
+                }
+            }
+            None => emitter.sample_area(u_area),
+        };
         let direction = match caster.cone_from(on_light.point) {
             Some((cos_theta_max, axis)) => {
                 Frame::from_normal(axis).to_world(warp::square_to_uniform_cone(u_direction, cos_theta_max))
@@ -131,14 +174,26 @@ impl CausticEmission {
         if cosine == 0.0 || (!light.two_sided && cosine < 0.0) {
             return None;
         }
-        let direction_pdf =
-            self.casters.iter().map(|c| c.pdf(on_light.point, direction)).sum::<f64>() / self.casters.len() as f64;
-        let area_pdf = 1.0 / emitter.area();
-        let valid = direction_pdf > 0.0 && area_pdf.is_finite() && select_probability > 0.0;
+        // The mixture over casters of (point density × direction density).
+        let whole_area = emitter.area();
+        let pdf = self
+            .casters
+            .iter()
+            .map(|c| {
+                let area_pdf = match c.region_of(light) {
+                    Some((_, cap, area)) if cap.contains(on_light.normal) => 1.0 / area,
+                    Some(_) => 0.0,
+                    None => 1.0 / whole_area,
+                };
+                area_pdf * c.pdf(on_light.point, direction)
+            })
+            .sum::<f64>()
+            / self.casters.len() as f64;
+        let valid = pdf > 0.0 && pdf.is_finite() && select_probability > 0.0;
         if !valid {
             return None;
         }
-        let flux = light.radiance * (cosine.abs() / (select_probability * area_pdf * direction_pdf));
+        let flux = light.radiance * (cosine.abs() / (select_probability * pdf));
         let facing = if cosine > 0.0 { on_light.normal } else { -on_light.normal };
         Some((Ray::spawn(on_light.point, on_light.point_error, facing, direction), flux))
     }
@@ -218,7 +273,7 @@ mod tests {
         let aimed: Vec<f64> = (0..n)
             .map(|i| {
                 let mut sampler = Sampler::new(SamplerKind::Random, i, 0, 3);
-                match emission.emit(&scene, &mut sampler, |_| true) {
+                match emission.emit(&scene, &mut sampler) {
                     Some((ray, flux)) if first_hit_specular(&ray) => {
                         reached += 1;
                         flux.x

@@ -18,9 +18,8 @@
 //!   lens needs a BSDF that can be evaluated), and
 //! - xₖ, the last surface before the light, is specular (a mirror or glass),
 //!   and
-//! - the light is one of the scene's emissive shapes (the sky, and spheres
-//!   cut by opaque spheres, are left to the camera paths: see
-//!   [`traces_caustics`]);
+//! - the light is one of the scene's emissive shapes (the sky is left to
+//!   the camera paths);
 //!
 //! and the path tracer ([`super::tracer`]) drops the emission it would have
 //! found along such a path (which it weighted 1, as light sampling cannot
@@ -36,7 +35,6 @@ use crate::color::Color;
 use crate::film::Film;
 use crate::integrator::sppm::photon::shading_normal_correction;
 use crate::integrator::sppm::visible_point::bsdf_inputs;
-use crate::light::Light;
 use crate::material::{ShadingPoint, Transport};
 use crate::math::{Frame as ShadingFrame, Ray};
 use crate::sampler::{Sampler, SamplerKind};
@@ -52,18 +50,10 @@ const PATHS_PER_CHUNK: u64 = 1024;
 /// camera samples of the pixel with the same index.
 const LIGHT_PATH_STREAM: u64 = 0x6c69_6768_7420_7061;
 
-/// Whether light paths trace the caustics of `light`: every light but a
-/// sphere cut by opaque spheres (smallpt's, of which only a sliver is in
-/// the room: photons drawn uniformly on its area would almost all start
-/// outside, the rare others carrying huge flux). Camera paths keep those.
-pub fn traces_caustics(light: &Light) -> bool {
-    light.clipped.is_none()
-}
-
-/// Whether light tracing can find anything in `scene`: it has a light
-/// whose caustics it traces and specular surfaces to focus its light.
+/// Whether light tracing can find anything in `scene`: it has a shape
+/// light and specular surfaces to focus its light.
 pub fn scene_has_caustics(scene: &Scene) -> bool {
-    scene.lights.lights.iter().any(traces_caustics) && scene.materials.iter().any(|m| m.is_specular())
+    !scene.lights.is_empty() && scene.materials.iter().any(|m| m.is_specular())
 }
 
 /// Light paths per pass for `pixels` sampled pixels: one per eight camera
@@ -150,7 +140,7 @@ pub fn trace(
     sampler: &mut Sampler,
     mut splat: impl FnMut(u32, u32, Color),
 ) {
-    let Some((mut ray, mut flux)) = emission.emit(scene, sampler, traces_caustics) else {
+    let Some((mut ray, mut flux)) = emission.emit(scene, sampler) else {
         return;
     };
     let aspect = width as f64 / height as f64;

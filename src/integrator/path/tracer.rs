@@ -5,7 +5,6 @@
 //!
 //! This file is the per-sample tracer; [`super`] drives it over the film.
 
-use super::caustic_paths::traces_caustics;
 use crate::color::Color;
 use crate::material::{ShadingPoint, Transport};
 use crate::math::{Frame as ShadingFrame, Ray, warp::power_heuristic};
@@ -90,14 +89,7 @@ impl PathTracer {
             // Emission found by the BSDF sample, weighted against light sampling.
             if let Some(emitted) = material.emission_towards(hit.geometric_normal.dot(wo_world)) {
                 let weight = match scene.lights.light_of_primitive(intersection.primitive) {
-                    Some(light)
-                        if self.caustics_by_light_paths
-                            && specular_bounce
-                            && first_surface_not_specular
-                            && traces_caustics(&scene.lights.lights[light as usize]) =>
-                    {
-                        0.0
-                    }
+                    Some(_) if self.caustics_by_light_paths && specular_bounce && first_surface_not_specular => 0.0,
                     Some(light) if light_sampling && !specular_bounce => {
                         let light_pdf = scene
                             .lights
