@@ -56,6 +56,22 @@ fn fixed_64(value: f64) -> i128 {
     (magnitude ^ negative) - negative
 }
 
+/// Adds `sample` (accepted) to per-channel sums kept in units of 2⁻⁶⁴.
+#[inline]
+fn add_color(sums: &mut [i128; 3], sample: Color) {
+    for (sum, value) in sums.iter_mut().zip(sample.to_array()) {
+        *sum = sum.wrapping_add(fixed_64(value));
+    }
+}
+
+/// Adds per-channel sums to per-channel sums (exact, in any order).
+#[inline]
+fn add_sums(sums: &mut [i128; 3], other: [i128; 3]) {
+    for (sum, other) in sums.iter_mut().zip(other) {
+        *sum = sum.wrapping_add(other);
+    }
+}
+
 /// A non-negative `value` (finite, < 2⁶³) with 32 fractional bits, rounded
 /// toward zero: trunc(value · 2³²).
 #[inline]
@@ -115,9 +131,7 @@ impl PixelAccumulator {
         if !accepts(sample) {
             return false;
         }
-        for (sum, value) in self.sum.iter_mut().zip(sample.to_array()) {
-            *sum = sum.wrapping_add(fixed_64(value));
-        }
+        add_color(&mut self.sum, sample);
         let y = luminance(sample);
         self.luminance_squared_sum = self.luminance_squared_sum.wrapping_add(fixed_32(y * y));
         self.count += 1;
@@ -129,9 +143,7 @@ impl PixelAccumulator {
     /// the count would pass `u32::MAX`.
     pub fn merge(&mut self, other: &PixelAccumulator) -> Option<()> {
         self.count = self.count.checked_add(other.count)?;
-        for (sum, other) in self.sum.iter_mut().zip(other.sum) {
-            *sum = sum.wrapping_add(other);
-        }
+        add_sums(&mut self.sum, other.sum);
         self.luminance_squared_sum = self.luminance_squared_sum.wrapping_add(other.luminance_squared_sum);
         Some(())
     }
@@ -213,10 +225,16 @@ impl LightSplats {
         if !accepts(value) {
             return false;
         }
-        for (sum, value) in self.sums[index].iter_mut().zip(value.to_array()) {
-            *sum = sum.wrapping_add(fixed_64(value));
-        }
+        add_color(&mut self.sums[index], value);
         true
+    }
+
+    /// Adds another film's light sums pixel by pixel (exact, order-free);
+    /// both must trace the same light paths per pass and have as many pixels.
+    pub fn merge(&mut self, other: &LightSplats) {
+        for (sums, other) in self.sums.iter_mut().zip(&other.sums) {
+            add_sums(sums, *other);
+        }
     }
 
     /// What pixel `index` adds to the estimate after `passes` passes.
@@ -284,18 +302,11 @@ impl Film {
         if (self.width, self.height) != (other.width, other.height) {
             return Err(FilmMergeError::Size(self.width, self.height, other.width, other.height));
         }
-        let empty = self.sample_count() == 0;
         match (&mut self.light, &other.light) {
             (None, None) => {}
-            (Some(light), Some(other)) if light.paths_per_pass == other.paths_per_pass => {
-                for (sums, other) in light.sums.iter_mut().zip(&other.sums) {
-                    for (sum, other) in sums.iter_mut().zip(other) {
-                        *sum = sum.wrapping_add(*other);
-                    }
-                }
-            }
+            (Some(light), Some(other)) if light.paths_per_pass == other.paths_per_pass => light.merge(other),
             // An empty film takes the other's light paths.
-            (None, Some(other)) if empty => self.light = Some(other.clone()),
+            (None, Some(other)) if self.pixels.iter().all(|p| p.count == 0) => self.light = Some(other.clone()),
             _ => return Err(FilmMergeError::LightPaths),
         }
         for (index, (pixel, other)) in self.pixels.iter_mut().zip(&other.pixels).enumerate() {

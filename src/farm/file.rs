@@ -299,11 +299,10 @@ pub fn add_film_file(path: &Path, film: &mut Film) -> Result<FilmHeader, FarmErr
         }
     };
     // Light paths must be alike in every part (an empty film takes the file's).
-    let empty = film.sample_count() == 0;
     match (&film.light, &light) {
         (None, None) => {}
         (Some(a), Some(b)) if a.paths_per_pass == b.paths_per_pass => {}
-        (None, Some(_)) if empty => {}
+        (None, Some(_)) if film.pixels.iter().all(|p| p.count == 0) => {}
         _ => {
             let describe = |light: Option<u64>| light.map_or("none".to_string(), |n| format!("{n} per pass"));
             return Err(FarmError::OtherImage {
@@ -326,13 +325,7 @@ pub fn add_film_file(path: &Path, film: &mut Film) -> Result<FilmHeader, FarmErr
         let _ = film.pixels[index].merge(&PixelAccumulator::from_exact_sums(sums));
     });
     match (&mut film.light, light) {
-        (Some(sums), Some(light)) => {
-            for (sums, light) in sums.sums.iter_mut().zip(light.sums) {
-                for (sum, add) in sums.iter_mut().zip(light) {
-                    *sum = sum.wrapping_add(add);
-                }
-            }
-        }
+        (Some(sums), Some(light)) => sums.merge(&light),
         (film_light, light) => *film_light = light.or(film_light.take()),
     }
     film.rejected_samples = film.rejected_samples.saturating_add(header.rejected_samples);
@@ -407,8 +400,7 @@ fn decode_records(bytes: &[u8], pixels: usize, mut each: impl FnMut(usize, Exact
             let count = next(32)?;
             let mut sum = [0i128; 3];
             for s in &mut sum {
-                let zigzag = next(128)?;
-                *s = ((zigzag >> 1) as i128) ^ -((zigzag & 1) as i128);
+                *s = unzigzag(next(128)?);
             }
             Ok((count, sum, next(128)?))
         })();
@@ -434,14 +426,18 @@ fn decode_light_records(bytes: &[u8], sums: &mut [[i128; 3]]) -> Result<usize, D
     let mut at = 0;
     for (index, pixel) in sums.iter_mut().enumerate() {
         for sum in pixel.iter_mut() {
-            let zigzag = read_varint(bytes, &mut at, 128).map_err(|e| match e {
+            *sum = unzigzag(read_varint(bytes, &mut at, 128).map_err(|e| match e {
                 VarintError::End => Decode::Short(index),
                 VarintError::TooLong => Decode::Invalid(index),
-            })?;
-            *sum = ((zigzag >> 1) as i128) ^ -((zigzag & 1) as i128);
+            })?);
         }
     }
     Ok(at)
+}
+
+/// The inverse of the zigzag encoding in [`encode_light_record`].
+fn unzigzag(zigzag: u128) -> i128 {
+    ((zigzag >> 1) as i128) ^ -((zigzag & 1) as i128)
 }
 
 enum VarintError {

@@ -67,16 +67,17 @@ pub fn paths_per_pass(pixels: usize) -> u64 {
     (pixels as u64).div_ceil(8)
 }
 
-/// Traces `film.light`'s paths per pass (light path i uses the sample
-/// stream (i, `sample_index`)) and adds their connections to the lens that
+/// Traces `film.light`'s paths per pass, aimed by `emission` and at most
+/// `max_depth` surfaces long (light path i uses the sample stream
+/// (i, `sample_index`)), and adds their connections to the lens that
 /// land on pixels (x, y) where `keep(x, y)` to `film.light` (nothing if it
 /// is `None`). False if cancelled, leaving the film unchanged.
 pub fn add_pass(
     film: &mut Film,
     scene: &Scene,
     camera: &Camera,
+    (emission, max_depth): (&CausticEmission, u32),
     keep: impl Fn(u32, u32) -> bool + Sync,
-    max_depth: u32,
     (kind, seed, sample_index): (SamplerKind, u64, u32),
     cancel: &AtomicBool,
 ) -> bool {
@@ -86,7 +87,6 @@ pub fn add_pass(
     };
     let paths = light.paths_per_pass;
     let chunks = paths.div_ceil(PATHS_PER_CHUNK);
-    let emission = CausticEmission::new(scene);
     let splats: Option<Vec<Vec<(usize, Color)>>> = (0..chunks)
         .into_par_iter()
         .map(|chunk| {
@@ -98,7 +98,7 @@ pub fn add_pass(
                 let mut sampler = Sampler::new(kind, index, sample_index, seed ^ LIGHT_PATH_STREAM);
                 trace(
                     scene,
-                    &emission,
+                    emission,
                     camera,
                     (width, height),
                     max_depth,

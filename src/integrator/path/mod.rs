@@ -10,6 +10,8 @@ pub mod tracer;
 
 pub use tracer::PathTracer;
 
+use caustic_emission::CausticEmission;
+
 use super::{Integrator, RowSet, Share, pass};
 use crate::camera::Camera;
 use crate::film::{Film, Frame, LightSplats};
@@ -36,10 +38,9 @@ pub struct PathIntegrator {
     adaptive_threshold: Option<f64>,
     /// Every pixel has met the adaptive threshold (see `Integrator::converged`).
     converged: bool,
-    /// Whether the settings ask for caustics traced from the lights and
-    /// nothing rules them out (see [`caustic_paths_apply`]); the scene then
-    /// decides whether they run.
-    caustic_paths: bool,
+    /// Where light paths for caustics are aimed, built at the first pass
+    /// that traces them (a render's scene does not change).
+    caustic_emission: Option<CausticEmission>,
 }
 
 /// Whether `settings` allow light-traced caustics: asked for, path tracing
@@ -72,7 +73,7 @@ impl PathIntegrator {
             rows: share.rows,
             adaptive_threshold: settings.adaptive_threshold,
             converged: false,
-            caustic_paths: caustic_paths_apply(settings),
+            caustic_emission: None,
         }
     }
 }
@@ -115,23 +116,25 @@ pub fn camera_ray(camera: &Camera, (width, height): (u32, u32), x: u32, y: u32, 
 impl Integrator for PathIntegrator {
     fn render_pass(&mut self, scene: &Scene, camera: &Camera, cancel: &AtomicBool) -> bool {
         let spectral = self.settings.spectral || scene.has_dispersion();
-        let light_traced = self.caustic_paths && !spectral && caustic_paths::scene_has_caustics(scene);
+        let light_traced = caustic_paths_apply(&self.settings) && !spectral && caustic_paths::scene_has_caustics(scene);
         self.tracer.caustics_by_light_paths = light_traced;
         if light_traced {
             let pixels = self.settings.sampled_pixels();
             let film = &mut self.film;
-            if film.light.is_none() && film.sample_count() == 0 {
+            if film.light.is_none() && self.passes == 0 {
                 film.light = Some(LightSplats::new(
                     caustic_paths::paths_per_pass(pixels.pixel_count()),
                     film.pixels.len(),
                 ));
             }
+            let emission = self.caustic_emission.get_or_insert_with(|| CausticEmission::new(scene));
             let stream = (self.sampler, self.seed, self.first_sample + self.passes);
             // Only this share's rows keep splats: every share traces the
             // light paths of its passes, and each pixel divides by its own.
             let rows = self.rows;
             let share_pixels = |x: u32, y: u32| pixels.contains(x, y) && rows.contains(y);
-            if !caustic_paths::add_pass(film, scene, camera, share_pixels, self.settings.max_depth, stream, cancel) {
+            let light = (&*emission, self.settings.max_depth);
+            if !caustic_paths::add_pass(film, scene, camera, light, share_pixels, stream, cancel) {
                 return false;
             }
         }
