@@ -40,6 +40,7 @@ pub fn sample(ior: f64, tint: Color, wo: DVec3, u_lobe: f64, transport: Transpor
             wi: reflect(wo),
             weight: tint,
             pdf: reflectance,
+            eta: 1.0,
             specular: true,
         });
     }
@@ -60,6 +61,7 @@ pub fn sample(ior: f64, tint: Color, wo: DVec3, u_lobe: f64, transport: Transpor
         wi: wi.normalize(),
         weight: tint * scale,
         pdf: 1.0 - reflectance,
+        eta,
         specular: true,
     })
 }

@@ -38,6 +38,7 @@ pub fn sample(albedo: Color, wo: DVec3, u: DVec2) -> Option<BsdfSample> {
         // f cos / pdf = (albedo/π) cos / (cos/π).
         weight: albedo,
         pdf,
+        eta: 1.0,
         specular: false,
     })
 }

@@ -114,6 +114,7 @@ pub fn sample(tint: Color, roughness: f64, wo: DVec3, u: DVec2) -> Option<BsdfSa
         wi,
         weight: schlick(tint, wo_up.dot(h)) * (g2 / g1),
         pdf: pdf(roughness, wo, wi),
+        eta: 1.0,
         specular: false,
     })
 }

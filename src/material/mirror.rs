@@ -11,6 +11,7 @@ pub fn sample(tint: Color, wo: DVec3) -> Option<BsdfSample> {
         wi: reflect(wo),
         weight: tint,
         pdf: 1.0,
+        eta: 1.0,
         specular: true,
     })
 }

@@ -48,6 +48,10 @@ pub struct BsdfSample {
     pub weight: Color,
     /// Density per steradian; for specular lobes the discrete probability of the lobe.
     pub pdf: f64,
+    /// The relative index of refraction n_transmitted / n_incident if `wi`
+    /// refracted, 1 otherwise. A radiance weight carries 1/η² of it, which
+    /// Russian roulette must not mistake for lost energy (pbrt-v4's etaScale).
+    pub eta: f64,
     /// Whether `wi` came from a delta lobe (mirror, glass): emission found
     /// along it gets no MIS weight, as light sampling could not have made it.
     pub specular: bool,
