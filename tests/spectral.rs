@@ -113,7 +113,7 @@ fn spectral_minus_rgb(loaded: &prism::scene::LoadedScene, runs: u64) -> [(f64, f
 }
 
 /// Spectral against RGB on the Cornell box (mirror and glass balls, no
-/// dispersion): per-channel image means within 1%.
+/// dispersion): per-channel image means within 1.5%.
 ///
 /// Where differences come from: the RGB → spectrum → RGB round trip is
 /// exact here (the uplift's basis is corrected to this film, residual below
@@ -124,7 +124,11 @@ fn spectral_minus_rgb(loaded: &prism::scene::LoadedScene, runs: u64) -> [(f64, f
 /// deeper than sRGB can show, with less blue than the RGB product. With
 /// Smits' basis spectra that cost the image 3.5% of its blue (−3.46% ±
 /// 0.29%, same statistic); the fitted basis, which multiplies nearly as RGB
-/// does (`spectrum::uplift` module doc), brings every channel within 1%.
+/// does (`spectrum::uplift` module doc), leaves about 1% in the blue under
+/// the shipped light: −0.89% ± 0.34%, and −1.04% ± 0.36% once Russian
+/// roulette stopped counting glass's 1/η² (which changes which paths the
+/// two draw, not what either converges to). Hence 1.5%, still well short
+/// of Smits' 3.5%.
 /// Under a white light only the red and green walls seen in each other are
 /// such products; with grey walls under the warm light every path meets one
 /// coloured spectrum, the light's, and the two must agree within noise.
@@ -161,7 +165,7 @@ fn spectral_and_rgb_agree_on_the_cornell_box() {
                 100.0 * error
             );
             assert!(
-                mean.abs() < 0.01,
+                mean.abs() < 0.015,
                 "{name}, channel {c}: spectral differs from RGB by {:.3}%",
                 100.0 * mean
             );
