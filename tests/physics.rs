@@ -3,7 +3,15 @@
 
 mod common;
 use common::{Job, assert_estimators_agree, mean_and_error, render, scene, shipped_scene};
+use glam::DVec3;
+use prism::integrator::path::PathTracer;
+use prism::math::Ray;
 use prism::render::IntegratorKind;
+use prism::sampler::{Sampler, SamplerKind};
+
+/// A lossless glass material and a ball of it at the origin, for [`furnace`].
+const GLASS: &str = "[materials.glass]\ntype = \"glass\"\nior = 1.5";
+const GLASS_BALL: &str = "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 3\nmaterial = \"glass\"";
 
 /// A uniformly emitting enclosure (radiance 1, seen from inside, so two-sided)
 /// around `inner` objects; the camera sits inside looking at the origin.
@@ -63,10 +71,7 @@ fn white_furnace_is_one_with_light_sampling_and_without() {
 /// well under 0.1% at these Fresnel weights).
 #[test]
 fn glass_neither_gains_nor_loses_energy() {
-    let loaded = scene(&furnace(
-        "[materials.glass]\ntype = \"glass\"\nior = 1.5",
-        "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 3\nmaterial = \"glass\"",
-    ));
+    let loaded = scene(&furnace(GLASS, GLASS_BALL));
     let (mean, error) = mean_and_error(
         &loaded,
         &Job {
@@ -79,6 +84,43 @@ fn glass_neither_gains_nor_loses_energy() {
         assert!(3.0 * error[c] < 0.01, "estimate too noisy to test: {error:?}");
         assert!((mean[c] - 1.0).abs() < 0.01, "channel {c}: mean {} ± {}", mean[c], error[c]);
     }
+}
+
+/// A lossless glass ball inside a uniform emitter of radiance 1: every
+/// path that leaves the glass sees radiance 1, so its estimate is the
+/// product of Russian roulette's 1/survival alone, at most 1/0.95 per
+/// bounce. Roulette that read the 1/η² compression inside the glass as
+/// lost energy would kill paths there and return the rest with at least
+/// η² = 2.25 (its mean stays 1: `glass_neither_gains_nor_loses_energy`).
+#[test]
+fn roulette_inside_glass_does_not_inflate_the_weights() {
+    let loaded = scene(&furnace(GLASS, GLASS_BALL));
+    let tracer = PathTracer {
+        max_depth: 8,
+        light_sampling: true,
+        caustics_by_light_paths: false,
+    };
+    let bound = (1.0 / 0.95_f64).powi(8) * (1.0 + 1e-9);
+    let (mut sum, mut largest) = (0.0, 0.0_f64);
+    let n = 20_000;
+    for i in 0..n {
+        let mut sampler = Sampler::new(SamplerKind::Random, i, 0, 7);
+        // Rays spread over the ball, so many refract at steep angles.
+        let target = DVec3::new(
+            2.9 * (i as f64 * 0.618).fract() - 1.45,
+            2.9 * (i as f64 * 0.377).fract() - 1.45,
+            0.0,
+        );
+        let ray = Ray::new(DVec3::new(0.0, 0.0, 8.0), target - DVec3::new(0.0, 0.0, 8.0));
+        let value = tracer.radiance(&loaded.scene, ray, &mut sampler).max_element();
+        sum += value;
+        largest = largest.max(value);
+    }
+    assert!(largest <= bound, "a sample of {largest} (bound {bound})");
+    // Teeth: paths do pass through the glass and leave it (the mean is
+    // near 1, less what depth 8 truncates).
+    let mean = sum / n as f64;
+    assert!((mean - 1.0).abs() < 0.05, "mean {mean}");
 }
 
 /// Next-event estimation with MIS and pure BSDF sampling estimate the same

@@ -9,6 +9,7 @@
 //! ([`triangles`]); `Shape::Triangle` describes one on its way there.
 
 pub mod axis_box;
+pub mod ball_optics;
 pub mod bezier;
 pub mod clipped_sphere;
 pub mod hit;
@@ -23,6 +24,7 @@ pub mod triangle;
 pub mod triangles;
 
 pub use axis_box::AxisBox;
+pub use ball_optics::{BallOptics, BallPath, Bounce};
 pub use clipped_sphere::ClippedSphere;
 pub use hit::{AreaSample, ShapeHit, SurfaceHit};
 pub use mesh::Mesh;

