@@ -192,3 +192,43 @@ fn smallpts_caustic_through_its_glass_ball_agrees_with_bsdf_sampling() {
         DVec3::new(73.0 + r * phi.cos(), 34.0, 78.0 + r * phi.sin())
     });
 }
+
+/// Only glass denser than the air around it (a bubble can reflect light
+/// totally on the way in) and untextured mirrors are connected through.
+#[test]
+fn bubbles_and_textured_mirrors_are_not_connected_through() {
+    let with = |material: &str| {
+        scene(&format!(
+            r#"
+            [camera]
+            position = [0, 0, 5]
+            look_at = [0, 0, 0]
+            [materials.ball]
+            {material}
+            [materials.light]
+            type = "emissive"
+            radiance = [1, 1, 1]
+            [[objects]]
+            type = "sphere"
+            center = [0, 0, 0]
+            radius = 1
+            material = "ball"
+            [[objects]]
+            type = "sphere"
+            center = [0, 3, 0]
+            radius = 0.5
+            material = "light"
+            "#
+        ))
+        .scene
+        .specular_balls()
+        .len()
+    };
+    assert_eq!(with("type = \"glass\"\nior = 1.33"), 1);
+    assert_eq!(with("type = \"glass\"\nior = 0.75"), 0);
+    assert_eq!(with("type = \"mirror\""), 1);
+    assert_eq!(
+        with("type = \"mirror\"\ntint = { checker = [[1, 1, 1], [0, 0, 0]], scale = 4 }"),
+        0
+    );
+}

@@ -13,7 +13,10 @@ use glam::DVec3;
 pub const MAX_SPECULAR_BALLS: usize = 8;
 
 /// A sphere of glass whose index does not vary with wavelength, or of a
-/// mirror whose colour does not vary over it.
+/// mirror whose colour does not vary over it. The glass is denser than
+/// the space around it (index above 1): light entering a bubble of lower
+/// index can be totally reflected, which the connection's paths through
+/// do not model.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SpecularBall {
     /// The sphere's primitive id in the scene.
@@ -42,7 +45,7 @@ pub(super) fn specular_balls(scene: &Scene) -> Vec<SpecularBall> {
                     ior,
                     tint,
                     dispersion: None,
-                } if ior != 1.0 && ior.is_finite() && ior > 0.0 => (Bounce::Through, ior, tint),
+                } if ior > 1.0 && ior.is_finite() => (Bounce::Through, ior, tint),
                 Material::Mirror {
                     tint: Texture::Constant(tint),
                 } => (Bounce::Off, 1.0, tint),
