@@ -6,7 +6,6 @@ use super::Scene;
 use crate::color::Color;
 use crate::geometry::{BallOptics, Bounce};
 use crate::material::{Material, Texture};
-use glam::DVec3;
 
 /// More specular balls than this and the connections are not made at all:
 /// each costs a root scan per ball per connected shading point.
@@ -34,7 +33,7 @@ pub struct SpecularBall {
 
 /// Every specular ball of `scene`, or none if there are more than [`MAX_SPECULAR_BALLS`].
 pub(super) fn specular_balls(scene: &Scene) -> Vec<SpecularBall> {
-    let balls: Vec<SpecularBall> = (0..scene.primitive_count() as u32)
+    let mut balls: Vec<SpecularBall> = (0..scene.primitive_count() as u32)
         .filter_map(|primitive| {
             let (center, radius) = scene.primitive_sphere(primitive)?;
             if !(radius > 0.0 && radius.is_finite() && center.is_finite()) {
@@ -56,22 +55,32 @@ pub(super) fn specular_balls(scene: &Scene) -> Vec<SpecularBall> {
                 optics: BallOptics { center, radius, ior },
                 bounce,
                 tint,
-                hollow: !reaches_inside(scene, primitive, center, radius),
+                hollow: true,
             })
         })
         .collect();
-    if balls.len() > MAX_SPECULAR_BALLS { Vec::new() } else { balls }
+    if balls.len() > MAX_SPECULAR_BALLS {
+        return Vec::new();
+    }
+    if !balls.is_empty() {
+        mark_reached_inside(scene, &mut balls);
+    }
+    balls
 }
 
-/// Whether the bounds of any primitive but `ball` come nearer than its
-/// radius to its centre (touching it from outside, as a floor a ball rests
-/// on, does not count).
-fn reaches_inside(scene: &Scene, ball: u32, center: DVec3, radius: f64) -> bool {
-    (0..scene.primitive_count() as u32)
-        .filter(|&primitive| primitive != ball)
-        .any(|primitive| {
-            let bounds = scene.primitive_bounds(primitive);
+/// Clears `hollow` on each ball that the bounds of another primitive come
+/// nearer than its radius to the centre of (touching it from outside, as a
+/// floor a ball rests on, does not count). One pass over the primitives,
+/// each one's bounds computed once for all the balls.
+fn mark_reached_inside(scene: &Scene, balls: &mut [SpecularBall]) {
+    for primitive in 0..scene.primitive_count() as u32 {
+        let bounds = scene.primitive_bounds(primitive);
+        for ball in balls.iter_mut().filter(|ball| ball.primitive != primitive) {
+            let BallOptics { center, radius, .. } = ball.optics;
             let nearest = center.clamp(bounds.min, bounds.max);
-            (nearest - center).length() < radius * (1.0 - 1e-9)
-        })
+            if (nearest - center).length() < radius * (1.0 - 1e-9) {
+                ball.hollow = false;
+            }
+        }
+    }
 }
