@@ -171,20 +171,23 @@ impl ClippedSphere {
         self.unclipped_from(reference, sample.normal).then_some(sample)
     }
 
+    /// A point of the emitter drawn uniformly by area on one of its caps
+    /// (density 1 / the cap's area).
+    pub fn sample_cap(&self, cap: &SphereCap, u: DVec2) -> AreaSample {
+        let normal = cap.sample_normal(u);
+        let (point, point_error) = self.sphere.point_with_normal(normal);
+        AreaSample {
+            point,
+            point_error,
+            normal,
+        }
+    }
+
     /// The point [`ClippedSphere::sample_from`] draws before it drops those
     /// a clipping sphere hides.
     fn sample_before_clipping(&self, reference: DVec3, u: DVec2) -> Option<ShapeSample> {
         match self.cap_to_sample(reference) {
-            Some((cap, area)) => {
-                let normal = cap.sample_normal(u);
-                let (point, point_error) = self.sphere.point_with_normal(normal);
-                let on_cap = AreaSample {
-                    point,
-                    point_error,
-                    normal,
-                };
-                sampling::by_area(on_cap, area, reference)
-            }
+            Some((cap, area)) => sampling::by_area(self.sample_cap(cap, u), area, reference),
             None => self.sphere.sample_from(reference, u),
         }
     }

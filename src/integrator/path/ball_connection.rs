@@ -107,16 +107,7 @@ fn light_point_seen_by(light: &Light, emitter: &Emitter, ball: &SpecularBall, u:
         .as_deref()
         .and_then(|clipped| Some((clipped, clipped.cap_seen_by_ball(ball.optics.center, ball.optics.radius)?)));
     let (sample, area) = match cap {
-        Some((clipped, (cap, area))) => {
-            let normal = cap.sample_normal(u);
-            let (point, point_error) = clipped.sphere.point_with_normal(normal);
-            let sample = AreaSample {
-                point,
-                point_error,
-                normal,
-            };
-            (sample, area)
-        }
+        Some((clipped, (cap, area))) => (clipped.sample_cap(&cap, u), area),
         None => (emitter.sample_area(u), emitter.area()),
     };
     (area > 0.0 && area.is_finite()).then_some((sample, area))

@@ -19,8 +19,8 @@
 //! densities.
 
 use crate::color::Color;
+use crate::geometry::ClippedSphere;
 use crate::geometry::clipped_sphere::SphereCap;
-use crate::geometry::{AreaSample, ClippedSphere};
 use crate::light::{EmitterSource, Light};
 use crate::math::{Aabb, DVec3, Frame, Ray, warp};
 use crate::sampler::Sampler;
@@ -153,15 +153,7 @@ impl CausticEmission {
         let emitter = scene.emitter(light.primitive);
         let caster = self.casters[((u_caster * self.casters.len() as f64) as usize).min(self.casters.len() - 1)];
         let on_light = match caster.region_of(light) {
-            Some((sphere, cap, _)) => {
-                let normal = cap.sample_normal(u_area);
-                let (point, point_error) = sphere.sphere.point_with_normal(normal);
-                AreaSample {
-                    point,
-                    point_error,
-                    normal,
-                }
-            }
+            Some((sphere, cap, _)) => sphere.sample_cap(&cap, u_area),
             None => emitter.sample_area(u_area),
         };
         let direction = match caster.cone_from(on_light.point) {
