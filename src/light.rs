@@ -61,6 +61,8 @@ pub struct LightSample<'a> {
     pub emission: Emission<'a>,
     /// Solid-angle density, including the probability of choosing this light.
     pub pdf: f64,
+    /// The light's primitive id in the scene.
+    pub primitive: u32,
 }
 
 /// The surface of an emissive primitive: a shape, or one of the scene's triangles.
@@ -208,6 +210,7 @@ impl Lights {
             normal: sample.normal,
             emission: light.emission(),
             pdf: sample.pdf * selection,
+            primitive: light.primitive,
         })
     }
 

@@ -204,3 +204,82 @@ fn closed_mesh_has_no_leaks_at_edges_and_vertices() {
     }
     assert_eq!(leaks, 0, "{leaks} of {rays} rays escaped the closed mesh");
 }
+
+/// A ray spawned on a quad may skip that quad (`Scene::leaving`), and a ray
+/// spawned on anything else may not: on the Cornell box (quad walls and
+/// light, a mirror ball and a glass ball), rays spawned from hits into both
+/// hemispheres, through the surface included, find the same nearest hit,
+/// bit for bit, and the same occlusion whether or not they skip. Rays into a
+/// ball from its own surface must find its far side, so were a ball ever
+/// skipped this would fail. Shadow rays to points on the quad light may
+/// skip that quad too.
+#[test]
+fn skipping_the_quad_a_ray_leaves_changes_no_answer() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.toml");
+    let scene = prism::scene::load_scene_file(&path).expect("scenes/cornell.toml loads").scene;
+    let mut state = 0x2545_f491_4f6c_dd1d_u64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    // A uniform direction, by rejection from the cube.
+    let direction = |next: &mut dyn FnMut() -> f64| loop {
+        let d = DVec3::new(2.0 * next() - 1.0, 2.0 * next() - 1.0, 2.0 * next() - 1.0);
+        if d.length_squared() > 1e-6 && d.length_squared() <= 1.0 {
+            break d;
+        }
+    };
+    let (mut from_quads, mut back_into_spheres, mut to_quad_lights) = (0, 0, 0);
+    for _ in 0..20_000 {
+        // From inside the room towards anything.
+        let origin = DVec3::new(5.0 + 545.0 * next(), 5.0 + 540.0 * next(), 5.0 + 545.0 * next());
+        let Some(found) = scene.intersect(&Ray::new(origin, direction(&mut next)), f64::INFINITY) else {
+            continue;
+        };
+        let hit = found.hit;
+        let leaving = scene.leaving(found.primitive);
+        if leaving != prism::scene::Leaving::Nothing {
+            from_quads += 1;
+        }
+        for _ in 0..4 {
+            let spawned = Ray::spawn(hit.point, hit.point_error, hit.geometric_normal, direction(&mut next));
+            let all = scene.intersect(&spawned, f64::INFINITY);
+            let skipping = scene.intersect_leaving(&spawned, f64::INFINITY, leaving);
+            assert_eq!(
+                all.map(|f| (f.primitive, f.hit.t.to_bits())),
+                skipping.map(|f| (f.primitive, f.hit.t.to_bits())),
+                "ray leaving primitive {}",
+                found.primitive
+            );
+            back_into_spheres +=
+                usize::from(leaving == prism::scene::Leaving::Nothing && all.is_some_and(|f| f.primitive == found.primitive));
+            let t_max = 600.0 * next();
+            let nothing = prism::scene::Leaving::Nothing;
+            assert_eq!(
+                scene.occluded(&spawned, t_max),
+                scene.occluded_between(&spawned, t_max, leaving, nothing)
+            );
+        }
+        // Shadow rays to the light, built as the path tracer builds them,
+        // may skip the light's quad as well.
+        let u = glam::DVec2::new(next(), next());
+        if let Some(light) = scene.lights.sample(&scene, hit.point, 0.5, u) {
+            let shadow = Ray::spawn(hit.point, hit.point_error, hit.geometric_normal, light.wi);
+            let t_max = (light.point - shadow.origin).length() * (1.0 - 1e-9) - light.point_error.length();
+            let target = scene.leaving(light.primitive);
+            to_quad_lights += usize::from(target != prism::scene::Leaving::Nothing);
+            assert_eq!(
+                scene.occluded(&shadow, t_max),
+                scene.occluded_between(&shadow, t_max, leaving, target)
+            );
+        }
+    }
+    assert!(from_quads > 10_000, "{from_quads} hits on quads");
+    assert!(
+        back_into_spheres > 100,
+        "{back_into_spheres} rays from a ball into the same ball"
+    );
+    assert!(to_quad_lights > 10_000, "{to_quad_lights} shadow rays to the quad light");
+}

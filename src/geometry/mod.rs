@@ -101,7 +101,7 @@ impl Shape {
             Shape::Sphere(s) => s.hit_distance(ray, t_max),
             Shape::AxisBox(b) => b.hit_distance(ray, t_max),
             Shape::Quad(q) => q.hit_distance(ray, t_max),
-            Shape::Revolution(r) => r.intersect(ray, t_max).map(|h| h.t),
+            Shape::Revolution(r) => r.hit_distance(ray, t_max),
         }
     }
 

@@ -33,16 +33,22 @@ const INVERSE_FACTORIALS: [f64; 19] = {
 ///
 /// Taylor series to x¹⁶ and x¹⁷: the first omitted terms, x¹⁸/18! and
 /// x¹⁹/19!, are below 3·10⁻¹⁸ and 9·10⁻²⁰ at π/4, where cos and sin are
-/// 0.707, so truncation costs under 0.03 ulp; the rest is Horner's rounding.
+/// 0.707, so truncation costs under 0.03 ulp; the rest is the evaluation's rounding.
 /// Outside |x| ≤ π/4 the truncation error grows quickly: use
 /// [`cos_sin_turns`] for larger angles.
 #[inline]
 pub fn cos_sin_eighth(x: f64) -> (f64, f64) {
     let f = &INVERSE_FACTORIALS;
-    let x2 = x * x;
-    // sin x = x (1 − x²/3! + x⁴/5! − …), cos x = 1 − x²/2! + x⁴/4! − …
-    let sin_tail = -f[3] + x2 * (f[5] + x2 * (-f[7] + x2 * (f[9] + x2 * (-f[11] + x2 * (f[13] + x2 * (-f[15] + x2 * f[17]))))));
-    let cos_tail = -f[2] + x2 * (f[4] + x2 * (-f[6] + x2 * (f[8] + x2 * (-f[10] + x2 * (f[12] + x2 * (-f[14] + x2 * f[16]))))));
+    let (x2, x4) = (x * x, x * x * (x * x));
+    let x8 = x4 * x4;
+    // sin x = x (1 − x²/3! + x⁴/5! − …), cos x = 1 − x²/2! + x⁴/4! − …,
+    // each tail a polynomial of degree 7 in x², by Estrin's scheme (Knuth,
+    // TAOCP vol. 2, §4.6.4): pairs of terms side by side, then pairs of
+    // pairs, so the chain of dependent operations is three multiply-adds
+    // deep instead of Horner's eight. A sampled direction is on a path's
+    // critical path (the next ray waits for it), so the latency counts.
+    let sin_tail = ((-f[3] + x2 * f[5]) + x4 * (-f[7] + x2 * f[9])) + x8 * ((-f[11] + x2 * f[13]) + x4 * (-f[15] + x2 * f[17]));
+    let cos_tail = ((-f[2] + x2 * f[4]) + x4 * (-f[6] + x2 * f[8])) + x8 * ((-f[10] + x2 * f[12]) + x4 * (-f[14] + x2 * f[16]));
     (1.0 + x2 * cos_tail, x + x * (x2 * sin_tail))
 }
 

@@ -42,6 +42,26 @@ pub struct Primitive {
     pub material: u32,
 }
 
+/// What a ray spawned on a surface cannot hit again (see [`Scene::leaving`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Leaving {
+    /// The ray may hit anything, the surface it left included.
+    Nothing,
+    /// The ray leaves this quad (a primitive id).
+    Quad(u32),
+}
+
+impl Leaving {
+    /// The shape index the leaf loops skip (`u32::MAX`, no shape, for nothing).
+    #[inline(always)]
+    fn shape_index(self) -> u32 {
+        match self {
+            Leaving::Nothing => u32::MAX,
+            Leaving::Quad(primitive) => primitive,
+        }
+    }
+}
+
 /// A hit and which primitive it belongs to.
 #[derive(Clone, Copy, Debug)]
 pub struct Intersection {
@@ -361,12 +381,45 @@ impl Scene {
         primitive.checked_sub(self.shapes.len() as u32)
     }
 
+    /// What a ray spawned on `primitive` may skip: the primitive itself if
+    /// it is a quad, which a ray leaving it cannot meet again (it is flat,
+    /// and the spawned origin lies off its plane on the side the ray leaves
+    /// by), else [`Leaving::Nothing`]. The same holds for a shadow ray
+    /// aimed at a point on a quad light, stopping short of it
+    /// ([`Scene::occluded_between`]). A ray leaving a wall enters the
+    /// wall's own box first (the box is the quad, rounded outward to `f32`,
+    /// far thicker than the origin's offset), so without this every bounce
+    /// off a quad tests that quad again, and the rejection is a
+    /// mispredicted branch.
+    pub fn leaving(&self, primitive: u32) -> Leaving {
+        match self.shapes.get(primitive as usize) {
+            Some(Primitive {
+                shape: Shape::Quad(_), ..
+            }) => Leaving::Quad(primitive),
+            _ => Leaving::Nothing,
+        }
+    }
+
     /// Nearest hit in `(0, t_max)`. Triangles report only distance and
     /// barycentrics during traversal, other shapes what their test found
     /// ([`ShapeHit`]); the hit record (normals, uv, error bounds) is built
     /// once, for the final hit, from those results.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<Intersection> {
+        self.intersect_skipping::<false>(ray, t_max, u32::MAX)
+    }
+
+    /// [`Scene::intersect`] for a ray spawned on a surface, which skips
+    /// what [`Scene::leaving`] says it cannot hit again.
+    #[inline]
+    pub fn intersect_leaving(&self, ray: &Ray, t_max: f64, leaving: Leaving) -> Option<Intersection> {
+        self.intersect_skipping::<true>(ray, t_max, leaving.shape_index())
+    }
+
+    /// The nearest hit, skipping shape `skipped` when `SKIP` (compiled
+    /// twice, so rays that skip nothing pay no comparison per shape).
+    #[inline(always)]
+    fn intersect_skipping<const SKIP: bool>(&self, ray: &Ray, t_max: f64, skipped: u32) -> Option<Intersection> {
         /// The nearest hit so far. Candidates are compared by distance
         /// alone; the hit record (normal, uv, error bounds) is built once,
         /// for the nearest, except for surfaces of revolution, whose root
@@ -395,6 +448,9 @@ impl Scene {
                 }
             } else {
                 for index in leaf.first..leaf.first + leaf.count {
+                    if SKIP && index == skipped {
+                        continue;
+                    }
                     let shape = &self.shapes[index as usize].shape;
                     if let Shape::Revolution(revolution) = shape {
                         if let Some(hit) = revolution.intersect(ray, *t_max) {
@@ -434,6 +490,22 @@ impl Scene {
     /// at the first hit found.
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f64) -> bool {
+        self.occluded_skipping::<false>(ray, t_max, u32::MAX, u32::MAX)
+    }
+
+    /// [`Scene::occluded`] for a shadow ray from one surface to a point on
+    /// another (a light), which skips what [`Scene::leaving`] says of each:
+    /// the ray cannot hit the quad it leaves, nor, before `t_max`, the quad
+    /// it is aimed at (a segment meets a plane once, and it ends there).
+    #[inline]
+    pub fn occluded_between(&self, ray: &Ray, t_max: f64, from: Leaving, to: Leaving) -> bool {
+        self.occluded_skipping::<true>(ray, t_max, from.shape_index(), to.shape_index())
+    }
+
+    /// Whether anything but shapes `skipped` and `target` (when `SKIP`)
+    /// lies on the ray before `t_max`.
+    #[inline(always)]
+    fn occluded_skipping<const SKIP: bool>(&self, ray: &Ray, t_max: f64, skipped: u32, target: u32) -> bool {
         let mut triangle_ray: Option<TriangleRay> = None;
         let mut t = t_max;
         let mut found = false;
@@ -444,8 +516,10 @@ impl Scene {
             } else if leaf.kind == SPHERE_LEAF {
                 self.spheres.occludes_leaf(ray, leaf.first, leaf.count, *t_max)
             } else {
-                (leaf.first..leaf.first + leaf.count)
-                    .any(|index| self.shapes[index as usize].shape.hit_distance(ray, *t_max).is_some())
+                (leaf.first..leaf.first + leaf.count).any(|index| {
+                    !(SKIP && (index == skipped || index == target))
+                        && self.shapes[index as usize].shape.hit_distance(ray, *t_max).is_some()
+                })
             };
             found
         });

@@ -45,6 +45,20 @@ pub(super) enum CandidateSurface {
 impl Revolution {
     /// The nearest intersection with `0 < t < t_max`, if any.
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
+        self.nearest(ray, t_max)
+            .map(|(local, candidate)| self.surface_hit(&local, candidate))
+    }
+
+    /// The distance to that intersection, without its record: what a
+    /// shadow ray needs. The record's angle, profile point, tangent, normal
+    /// and error bounds (an `atan2`, a `sin_cos`, a `hypot` and two Bézier
+    /// evaluations) cost as much as a few pieces of root isolation.
+    pub fn hit_distance(&self, ray: &Ray, t_max: f64) -> Option<f64> {
+        self.nearest(ray, t_max).map(|(_, candidate)| candidate.s)
+    }
+
+    /// The nearest candidate with `0 < t < t_max`, and the ray in the local frame.
+    fn nearest(&self, ray: &Ray, t_max: f64) -> Option<(LocalRay, Candidate)> {
         let local = LocalRay::new(
             self.world_to_local.transform_point3(ray.origin),
             self.world_to_local.transform_vector3(ray.direction),
@@ -86,7 +100,7 @@ impl Revolution {
             }
             segment.intersect(&local, index, self.size, &cutoff, &mut consider);
         }
-        best.map(|candidate| self.surface_hit(&local, candidate))
+        best.map(|candidate| (local, candidate))
     }
 
     /// Builds the reported hit for the chosen candidate.

@@ -10,7 +10,7 @@ use crate::color::Color;
 use crate::material::{ShadingPoint, Transport};
 use crate::math::{Frame as ShadingFrame, Ray, warp::power_heuristic};
 use crate::sampler::Sampler;
-use crate::scene::Scene;
+use crate::scene::{Leaving, Scene};
 use crate::settings::{IntegratorKind, RenderSettings};
 use crate::spectrum::{Radiance, SampledSpectrum, SampledWavelengths};
 use glam::DVec2;
@@ -103,9 +103,11 @@ impl PathTracer {
         // Every surface so far was a mirror or glass: the camera sees the
         // current one only through them.
         let mut specular_chain = true;
+        // The surface the current ray leaves, which it cannot hit again.
+        let mut leaving = Leaving::Nothing;
 
         for bounce in 0.. {
-            let Some(intersection) = scene.intersect(&ray, f64::INFINITY) else {
+            let Some(intersection) = scene.intersect_leaving(&ray, f64::INFINITY, leaving) else {
                 radiance += throughput * C::from_rgb(scene.background, wavelengths);
                 break;
             };
@@ -135,6 +137,7 @@ impl PathTracer {
                 first_surface_not_specular = !material.is_specular();
             }
 
+            let here = scene.leaving(intersection.primitive);
             let frame = ShadingFrame::from_normal(hit.shading_normal);
             let wo = frame.to_local(wo_world);
             let at = ShadingPoint {
@@ -169,7 +172,7 @@ impl PathTracer {
                         let distance = (light.point - shadow.origin).length();
                         // Stop short of the light by far more than its point error.
                         let t_max = distance * (1.0 - 1e-9) - light.point_error.length();
-                        if !scene.occluded(&shadow, t_max) {
+                        if !scene.occluded_between(&shadow, t_max, here, scene.leaving(light.primitive)) {
                             let weight = power_heuristic(light.pdf, material.pdf(wo, wi));
                             let f = C::from_rgb(f, wavelengths);
                             radiance += throughput * f * C::emission(light.emission, wavelengths) * (weight / light.pdf);
@@ -197,6 +200,7 @@ impl PathTracer {
             previous_point = hit.point;
             let direction = frame.to_world(sample.wi);
             ray = Ray::spawn(hit.point, hit.point_error, hit.geometric_normal, direction);
+            leaving = here;
             if balls {
                 passage = match connected_by_balls {
                     true => Passage::Left(Departure {
