@@ -387,10 +387,10 @@ impl Scene {
     /// by), else [`Leaving::Nothing`]. The same holds for a shadow ray
     /// aimed at a point on a quad light, stopping short of it
     /// ([`Scene::occluded_between`]). A ray leaving a wall enters the
-    /// wall's own box first (the box is the quad, rounded outward to `f32`,
-    /// far thicker than the origin's offset), so without this every bounce
-    /// off a quad tests that quad again, and the rejection is a
-    /// mispredicted branch.
+    /// wall's own box first (the conservative `f32` box test brackets the
+    /// origin to within an `f32` ulp, far more than its offset from the
+    /// wall), so without this every bounce off a quad tests that quad
+    /// again, and the rejection is a mispredicted branch.
     pub fn leaving(&self, primitive: u32) -> Leaving {
         match self.shapes.get(primitive as usize) {
             Some(Primitive {
