@@ -165,6 +165,18 @@ fn icosphere(subdivisions: u32) -> Vec<[DVec3; 3]> {
     triangles
 }
 
+/// Uniform numbers in [0, 1) from a fixed xorshift64 stream (Marsaglia
+/// 2003): the same rays on every run.
+fn uniform_stream() -> impl FnMut() -> f64 {
+    let mut state = 0x2545_f491_4f6c_dd1d_u64;
+    move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 /// 10⁶ rays from inside a closed mesh, aimed exactly at its vertices and at
 /// points on its edges: every one must hit (a miss is a leak). The
 /// watertight test guarantees this; a naive Möller–Trumbore does not.
@@ -173,13 +185,7 @@ fn closed_mesh_has_no_leaks_at_edges_and_vertices() {
     let triangles = icosphere(3);
     let scene = Scene::from_mesh(Mesh::from_triangles(&triangles));
 
-    let mut state = 0x2545_f491_4f6c_dd1du64;
-    let mut next = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = uniform_stream();
     let mut leaks = 0;
     let mut rays = 0;
     let target_count = 1_000_000;
@@ -217,13 +223,7 @@ fn closed_mesh_has_no_leaks_at_edges_and_vertices() {
 fn skipping_the_quad_a_ray_leaves_changes_no_answer() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.toml");
     let scene = prism::scene::load_scene_file(&path).expect("scenes/cornell.toml loads").scene;
-    let mut state = 0x2545_f491_4f6c_dd1d_u64;
-    let mut next = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = uniform_stream();
     // A uniform direction, by rejection from the cube.
     let direction = |next: &mut dyn FnMut() -> f64| loop {
         let d = DVec3::new(2.0 * next() - 1.0, 2.0 * next() - 1.0, 2.0 * next() - 1.0);
