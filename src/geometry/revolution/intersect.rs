@@ -2,8 +2,9 @@
 //!
 //! The ray is taken into the rotated local frame (`LocalRay`); caps are
 //! tried first (they are cheap, and a near cap hit prunes the profile), then
-//! each segment inside whose bounding cylinder the ray passes
-//! (`segment_hits`). Only the nearest hit matters, so
+//! each segment inside whose bounding cylinder the ray passes, arc by arc,
+//! in the order the ray enters their annuli (`segment_hits`). Only the
+//! nearest hit matters, so
 //! the search keeps the nearest verified hit so far and root isolation skips
 //! every piece of the profile whose hits can only be farther
 //! (`RayProfilePiece::nearest_parameter`). Together with stopping Newton once
@@ -18,7 +19,7 @@
 //! object's size of tangency may be reported as hit or miss.
 
 use super::local_ray::LocalRay;
-use super::profile::{Cap, Segment};
+use super::profile::{Arc, Cap, Segment};
 use super::{Revolution, profile_normal};
 use crate::geometry::bezier;
 use crate::geometry::hit::SurfaceHit;
@@ -174,6 +175,35 @@ impl Cap {
         let s_error = 2.0 * gamma(3) * (self.z.abs() + ray.origin.z.abs()) / dz.abs();
         let point = ray.origin + s * ray.direction;
         (s > s_error && point.x.hypot(point.y) <= self.radius).then_some(s)
+    }
+}
+
+impl Arc {
+    /// A lower bound on the ray parameters `s ≥ 0` at which the ray is
+    /// inside this arc's annulus, or `None` if it never is there.
+    pub(super) fn entry(&self, ray: &LocalRay, margin: f64) -> Option<f64> {
+        let (entry, exit) = ray.cylinder_span(self.radius * (1.0 + 1e-9) + margin, self.z_min - margin, self.z_max + margin)?;
+        if exit < 0.0 {
+            return None;
+        }
+        // The squared distance to the axis, `(o + s h)² + δ²`, is convex in
+        // `s`: if it is below the inner radius at both ends of the span, it
+        // is below it throughout, and the ray passes through the hole.
+        let inner = self.inner_radius * (1.0 - 1e-9) - margin;
+        if inner > 0.0 {
+            let across = ray.across.abs();
+            let inside_hole = |s: f64| {
+                let along = ray.along + s * ray.horizontal_speed;
+                // Rounding of the square, and of `o` and `δ` (`frame_error`).
+                let extent = ray.along.abs() + (s * ray.horizontal_speed).abs() + across;
+                let slack = gamma(8) * extent * extent + 3.0 * extent * ray.frame_error;
+                along * along + across * across + slack < inner * inner
+            };
+            if inside_hole(entry.max(0.0)) && inside_hole(exit) {
+                return None;
+            }
+        }
+        Some(entry)
     }
 }
 

@@ -50,7 +50,7 @@ pub struct Revolution {
     absolute_linear: DMat3,
     /// Uniform scale factor of the similarity transform.
     scale_factor: f64,
-    /// Largest `x`, and the `y` range, of all control points.
+    /// Bounding cylinder of the whole profile: the segments' cylinders.
     radius: f64,
     z_min: f64,
     z_max: f64,
@@ -128,8 +128,14 @@ impl Revolution {
         let radius = segments.iter().fold(0.0_f64, |m, s| m.max(s.radius));
         let z_min = segments.iter().fold(f64::INFINITY, |m, s| m.min(s.z_min));
         let z_max = segments.iter().fold(f64::NEG_INFINITY, |m, s| m.max(s.z_max));
+        // The scale of rounding errors is that of the coefficients, the
+        // control points, which may reach beyond the curve.
+        let size = segments
+            .iter()
+            .flat_map(|segment| &segment.points)
+            .fold(0.0_f64, |m, p| m.max(p.x.abs()).max(p.y.abs()));
         Ok(Self {
-            size: radius.max(z_min.abs()).max(z_max.abs()),
+            size,
             segments,
             caps: cap_list,
             local_to_world,

@@ -1,6 +1,8 @@
 //! The hits of a ray with one segment of the profile: the roots of the
 //! ray–profile polynomial (`ray_profile`), each turned into a ray parameter
-//! and verified to lie on the surface.
+//! and verified to lie on the surface. Roots are isolated arc by arc
+//! (`profile::Arc`), only on the arcs whose annuli the ray passes through,
+//! nearest first.
 //!
 //! For each root the ray parameter comes from whichever formula has the
 //! smaller error bound: the height equation `s = (y − O_z) / D_z` (good for
@@ -19,7 +21,7 @@
 
 use super::intersect::{Candidate, CandidateSurface};
 use super::local_ray::LocalRay;
-use super::profile::Segment;
+use super::profile::{Arc, MAX_ARCS, Segment};
 use super::ray_profile::{RayProfilePiece, range};
 use crate::geometry::bezier::{self, MAX_CONTROL_POINTS};
 use crate::math::bernstein::{self, MAX_COEFFICIENTS};
@@ -63,7 +65,7 @@ impl Segment {
                     let radial = RadialSolution::new(ray, point.x, derivative.x, root.t_uncertainty, n);
                     for branch in [-1.0, 1.0] {
                         if let Some(s) = radial.parameter(branch) {
-                            self.verify_and_report(ray, index, size, root, s, radial.error, consider);
+                            self.verify_and_report(ray, index, size, root, (point, derivative), s, radial.error, consider);
                         }
                     }
                 },
@@ -92,31 +94,78 @@ impl Segment {
         let dz = ray.direction.z;
         let h = ray.horizontal_speed;
         let origin_z = ray.origin.z;
-        let mut a = [0.0; N];
-        let mut x = [0.0; N];
-        for i in 0..=n {
-            a[i] = h * (self.y[i] - origin_z) + dz * ray.along;
-            x[i] = self.x[i];
+        // The arcs whose annuli the ray passes through before the nearest
+        // hit so far, nearest entry first, so that an early hit prunes the
+        // arcs behind it.
+        let margin = 1e-9 * size;
+        let mut order = [(0.0, 0_usize); MAX_ARCS];
+        let mut crossed = 0;
+        for (arc_index, arc) in self.arcs.iter().enumerate() {
+            let Some(entry) = arc.entry(ray, margin) else {
+                continue;
+            };
+            if entry >= cutoff.get() {
+                continue;
+            }
+            let mut place = crossed;
+            while place > 0 && order[place - 1].0 > entry {
+                order[place] = order[place - 1];
+                place -= 1;
+            }
+            order[place] = (entry, arc_index);
+            crossed += 1;
         }
-        let piece = RayProfilePiece {
-            a,
-            x,
-            count: n + 1,
-            a_range: range(&a[..=n]),
-            x_range: range(&x[..=n]),
-            dz_squared: dz * dz,
-            across: ray.across,
-            width: 1.0,
-            a_error: 0.0,
-            x_error: 0.0,
-            a_rounding: gamma(4) * (h * (self.height_size + origin_z.abs()) + (dz * ray.along).abs())
-                + dz.abs() * ray.frame_error,
-        };
+        for &(entry, arc_index) in &order[..crossed] {
+            if entry >= cutoff.get() {
+                break;
+            }
+            let arc = &self.arcs[arc_index];
+            let mut a = [0.0; N];
+            let mut x = [0.0; N];
+            for i in 0..=n {
+                a[i] = h * (arc.y[i] - origin_z) + dz * ray.along;
+                x[i] = arc.x[i];
+            }
+            let piece = RayProfilePiece {
+                a,
+                x,
+                count: n + 1,
+                a_range: range(&a[..=n]),
+                x_range: range(&x[..=n]),
+                dz_squared: dz * dz,
+                across: ray.across,
+                width: arc.t1 - arc.t0,
+                a_error: h * arc.y_error,
+                x_error: arc.x_error,
+                a_rounding: gamma(4) * (h * (self.height_size + arc.y_error + origin_z.abs()) + (dz * ray.along).abs())
+                    + dz.abs() * ray.frame_error,
+            };
+            self.isolate_arc(ray, index, size, arc, &piece, cutoff, consider);
+        }
+    }
+
+    /// Reports the verified hits of the ray with one arc, whose ray–profile
+    /// polynomial is `piece`.
+    #[allow(clippy::too_many_arguments)]
+    fn isolate_arc<const N: usize>(
+        &self,
+        ray: &LocalRay,
+        index: usize,
+        size: f64,
+        arc: &Arc,
+        piece: &RayProfilePiece<N>,
+        cutoff: &Cell<f64>,
+        consider: &mut impl FnMut(Candidate),
+    ) {
+        let n = self.degree;
+        let dz = ray.direction.z;
+        let h = ray.horizontal_speed;
+        let origin_z = ray.origin.z;
         let mut skip = |piece: &RayProfilePiece<N>| piece.nearest_parameter(ray) > cutoff.get();
         roots::isolate_roots(
-            &piece,
-            0.0,
-            1.0,
+            piece,
+            arc.t0,
+            arc.t1,
             MINIMUM_ROOT_WIDTH,
             &mut skip,
             &mut |piece: &RayProfilePiece<N>, root| {
@@ -132,18 +181,18 @@ impl Segment {
                 let a_error = piece.a_error + gamma(n as u32 + 2) * a_largest + a_slope.abs() / piece.width * root.t_uncertainty;
                 let radial = RadialSolution::new(ray, point.x, derivative.x, root.t_uncertainty, n);
                 if height_error <= radial.error || h == 0.0 {
-                    self.verify_and_report(ray, index, size, root, s_height, height_error, consider);
+                    self.verify_and_report(ray, index, size, root, (point, derivative), s_height, height_error, consider);
                 } else if a_value.abs() > a_error {
                     let branch = a_value.signum() * dz.signum();
                     if let Some(s) = radial.parameter(branch) {
-                        self.verify_and_report(ray, index, size, root, s, radial.error, consider);
+                        self.verify_and_report(ray, index, size, root, (point, derivative), s, radial.error, consider);
                     }
                 } else {
                     // Entry and exit are not separable: both are surface points
                     // within the error bounds.
                     for branch in [-1.0, 1.0] {
                         if let Some(s) = radial.parameter(branch) {
-                            self.verify_and_report(ray, index, size, root, s, radial.error, consider);
+                            self.verify_and_report(ray, index, size, root, (point, derivative), s, radial.error, consider);
                         }
                     }
                 }
@@ -154,6 +203,7 @@ impl Segment {
     /// Checks that the ray point at `s` lies on the profile's tangent line at
     /// the root (distance in the meridian plane, within the error bounds) and
     /// that `s` exceeds its own error bound, then reports the candidate.
+    /// `profile` and `derivative` are the curve's point and tangent at the root.
     #[allow(clippy::too_many_arguments)]
     fn verify_and_report(
         &self,
@@ -161,6 +211,7 @@ impl Segment {
         index: usize,
         size: f64,
         root: IsolatedRoot,
+        (profile, derivative): (DVec2, DVec2),
         s: f64,
         s_error: f64,
         consider: &mut impl FnMut(Candidate),
@@ -170,7 +221,6 @@ impl Segment {
             return;
         }
         let point = ray.origin + s * ray.direction;
-        let (profile, derivative) = bezier::evaluate_with_derivative(&self.points, root.t);
         let radial = point.x.hypot(point.y);
         let offset = DVec2::new(radial, point.z) - profile;
         let speed = derivative.length();
