@@ -67,7 +67,18 @@ pub(super) struct RayProfilePiece<const N: usize> {
     pub(super) a_rounding: f64,
 }
 
+/// Pieces of at most this many coefficients are built with exactly `N`
+/// (see `Segment::intersect`), so their loops have bounds known at compile
+/// time and unroll.
+pub(super) const MAX_EXACT_SIZE: usize = 8;
+
 impl<const N: usize> RayProfilePiece<N> {
+    /// The number of coefficients of both factors.
+    #[inline(always)]
+    fn len(&self) -> usize {
+        if N <= MAX_EXACT_SIZE { N } else { self.count.min(N) }
+    }
+
     /// `F`'s Bernstein coefficient at an end of the piece, from the factors'
     /// coefficients there (`c_0 = a_0² − D_z² x_0² + D_z² δ²`, likewise `c_2n`).
     fn end_value(&self, a: f64, x: f64) -> f64 {
@@ -77,7 +88,7 @@ impl<const N: usize> RayProfilePiece<N> {
     /// `a`, `da/dτ`, `x` and `dx/dτ` at `τ`, by de Casteljau's algorithm on
     /// both factors at once (as `bernstein::evaluate_with_derivative`).
     fn factors_at(&self, tau: f64) -> (f64, f64, f64, f64) {
-        let count = self.count.min(N);
+        let count = self.len();
         if count < 2 {
             return (self.a[0], 0.0, self.x[0], 0.0);
         }
@@ -131,7 +142,7 @@ impl<const N: usize> RayProfilePiece<N> {
 
 impl<const N: usize> PolynomialPiece for RayProfilePiece<N> {
     fn coefficients(&self, out: &mut [f64; MAX_COEFFICIENTS]) -> (usize, f64) {
-        let n = self.count - 1;
+        let n = self.len() - 1;
         // Quick exclusion from the factors' ranges (convex hull): if
         // min a² − D_z²(max x² − δ²) > 0, or max a² − D_z²(min x² − δ²) < 0,
         // F keeps one sign; report two coefficients of that sign.
@@ -162,7 +173,7 @@ impl<const N: usize> PolynomialPiece for RayProfilePiece<N> {
         // Scaled factors C(n,i) a_i, then c_k = Σ_{i+j=k} (…) / C(2n,k); the
         // sum is symmetric in i and j, so each pair i < j is formed once and
         // doubled (exact in binary).
-        let count = self.count.min(N);
+        let count = self.len();
         let mut a_scaled = [0.0; N];
         let mut x_scaled = [0.0; N];
         for ((i, &weight), (a, x)) in binomial_row(n)
@@ -199,14 +210,14 @@ impl<const N: usize> PolynomialPiece for RayProfilePiece<N> {
     }
 
     fn end_values(&self) -> (f64, f64) {
-        let n = self.count - 1;
+        let n = self.len() - 1;
         (self.end_value(self.a[0], self.x[0]), self.end_value(self.a[n], self.x[n]))
     }
 
     fn split_half(&self) -> (Self, Self) {
         let mut left = *self;
         let mut right = *self;
-        let count = self.count.min(N);
+        let count = self.len();
         // de Casteljau at ½ on both factors (as `bernstein::split`):
         // the left edge of the triangle is the left half, the right edge the
         // right half.

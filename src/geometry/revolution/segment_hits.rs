@@ -22,7 +22,7 @@
 use super::intersect::{Candidate, CandidateSurface};
 use super::local_ray::LocalRay;
 use super::profile::{Arc, MAX_ARCS, Segment};
-use super::ray_profile::{RayProfilePiece, range};
+use super::ray_profile::{MAX_EXACT_SIZE, RayProfilePiece, range};
 use crate::geometry::bezier::{self, MAX_CONTROL_POINTS};
 use crate::math::bernstein::{self, MAX_COEFFICIENTS};
 use crate::math::gamma;
@@ -74,14 +74,21 @@ impl Segment {
         }
         // General case: roots of F = a² − D_z² (x² − δ²), with pieces sized
         // to the degree (they are copied at every split).
+        // Up to `MAX_EXACT_SIZE` coefficients the size is exact.
         match n + 1 {
-            ..=4 => self.intersect_general::<4>(ray, index, size, cutoff, consider),
-            5..=8 => self.intersect_general::<8>(ray, index, size, cutoff, consider),
+            2 => self.intersect_general::<2>(ray, index, size, cutoff, consider),
+            3 => self.intersect_general::<3>(ray, index, size, cutoff, consider),
+            4 => self.intersect_general::<4>(ray, index, size, cutoff, consider),
+            5 => self.intersect_general::<5>(ray, index, size, cutoff, consider),
+            6 => self.intersect_general::<6>(ray, index, size, cutoff, consider),
+            7 => self.intersect_general::<7>(ray, index, size, cutoff, consider),
+            8 => self.intersect_general::<8>(ray, index, size, cutoff, consider),
             _ => self.intersect_general::<MAX_CONTROL_POINTS>(ray, index, size, cutoff, consider),
         }
     }
 
-    /// `intersect` for `D_z ≠ 0`, with pieces of `N ≥ degree + 1` coefficients.
+    /// `intersect` for `D_z ≠ 0`, with pieces of `N ≥ degree + 1`
+    /// coefficients (`N = degree + 1` up to `MAX_EXACT_SIZE`).
     fn intersect_general<const N: usize>(
         &self,
         ray: &LocalRay,
@@ -91,6 +98,7 @@ impl Segment {
         consider: &mut impl FnMut(Candidate),
     ) {
         let n = self.degree;
+        debug_assert!(N > MAX_EXACT_SIZE || N == n + 1);
         let dz = ray.direction.z;
         let h = ray.horizontal_speed;
         let origin_z = ray.origin.z;
