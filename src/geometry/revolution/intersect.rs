@@ -99,7 +99,7 @@ impl Revolution {
             if exit < 0.0 || entry >= cutoff.get() {
                 continue;
             }
-            segment.intersect(&local, index, self.size, &cutoff, &mut consider);
+            segment.intersect(&local, index, self.size, (entry, exit), &cutoff, &mut consider);
         }
         best.map(|candidate| (local, candidate))
     }

@@ -34,12 +34,14 @@ use std::cell::Cell;
 const MINIMUM_ROOT_WIDTH: f64 = 1e-13;
 
 impl Segment {
-    /// Reports every verified candidate hit of the ray with this segment.
+    /// Reports every verified candidate hit of the ray with this segment,
+    /// whose bounding cylinder it is inside for `s ∈ span`.
     pub(super) fn intersect(
         &self,
         ray: &LocalRay,
         index: usize,
         size: f64,
+        span: (f64, f64),
         cutoff: &Cell<f64>,
         consider: &mut impl FnMut(Candidate),
     ) {
@@ -76,14 +78,14 @@ impl Segment {
         // to the degree (they are copied at every split).
         // Up to `MAX_EXACT_SIZE` coefficients the size is exact.
         match n + 1 {
-            2 => self.intersect_general::<2>(ray, index, size, cutoff, consider),
-            3 => self.intersect_general::<3>(ray, index, size, cutoff, consider),
-            4 => self.intersect_general::<4>(ray, index, size, cutoff, consider),
-            5 => self.intersect_general::<5>(ray, index, size, cutoff, consider),
-            6 => self.intersect_general::<6>(ray, index, size, cutoff, consider),
-            7 => self.intersect_general::<7>(ray, index, size, cutoff, consider),
-            8 => self.intersect_general::<8>(ray, index, size, cutoff, consider),
-            _ => self.intersect_general::<MAX_CONTROL_POINTS>(ray, index, size, cutoff, consider),
+            2 => self.intersect_general::<2>(ray, index, size, span, cutoff, consider),
+            3 => self.intersect_general::<3>(ray, index, size, span, cutoff, consider),
+            4 => self.intersect_general::<4>(ray, index, size, span, cutoff, consider),
+            5 => self.intersect_general::<5>(ray, index, size, span, cutoff, consider),
+            6 => self.intersect_general::<6>(ray, index, size, span, cutoff, consider),
+            7 => self.intersect_general::<7>(ray, index, size, span, cutoff, consider),
+            8 => self.intersect_general::<8>(ray, index, size, span, cutoff, consider),
+            _ => self.intersect_general::<MAX_CONTROL_POINTS>(ray, index, size, span, cutoff, consider),
         }
     }
 
@@ -94,6 +96,7 @@ impl Segment {
         ray: &LocalRay,
         index: usize,
         size: f64,
+        span: (f64, f64),
         cutoff: &Cell<f64>,
         consider: &mut impl FnMut(Candidate),
     ) {
@@ -106,9 +109,20 @@ impl Segment {
         // hit so far, nearest entry first, so that an early hit prunes the
         // arcs behind it.
         let margin = 1e-9 * size;
+        // First by height alone: the heights the ray passes through inside
+        // the segment's cylinder, before the nearest hit so far, widened by
+        // their rounding. Arcs beside that range cost two comparisons, not
+        // a cylinder test's square root and divisions.
+        let (near, far) = (span.0.max(0.0), span.1.min(cutoff.get()));
+        let (z_near, z_far) = (origin_z + near * dz, origin_z + far * dz);
+        let z_slack = margin + gamma(2) * (origin_z.abs() + (near * dz).abs().max((far * dz).abs()));
+        let (z_low, z_high) = (z_near.min(z_far) - z_slack, z_near.max(z_far) + z_slack);
         let mut order = [(0.0, 0_usize); MAX_ARCS];
         let mut crossed = 0;
         for (arc_index, arc) in self.arcs.iter().enumerate() {
+            if arc.z_max < z_low || arc.z_min > z_high {
+                continue;
+            }
             let Some(entry) = arc.entry(ray, margin) else {
                 continue;
             };
