@@ -507,9 +507,7 @@ mod tests {
             MAX_SAMPLE_VALUE - 1.0,
         ];
         for _ in 0..200_000 {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
+            crate::math::xorshift64(&mut state);
             // Random significand and sign, exponent from subnormal to 2³¹.
             let exponent = (state >> 52) % 1054;
             let bits = (state & ((1 << 52) - 1)) | (exponent << 52) | (state & (1 << 63));

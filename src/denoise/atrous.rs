@@ -468,12 +468,7 @@ mod tests {
         let (width, height) = (13, 9);
         let count = width * height;
         let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut uniform = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut uniform = move || (crate::math::xorshift64(&mut state) >> 40) as f32 / (1u64 << 24) as f32;
         let tilted = [0.0, 0.1f32.sin(), 0.1f32.cos()];
         let choices = [[0.0, 0.0, 1.0], tilted, [1.0, 0.0, 0.0], [0.0; 3]];
         let normals: Vec<[f32; 3]> = (0..count).map(|_| choices[((uniform() * 4.0) as usize).min(3)]).collect();

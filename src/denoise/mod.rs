@@ -178,12 +178,7 @@ mod tests {
         let count = (width * height) as usize;
         // A fixed pseudo-random sequence (xorshift), uniform in [0, 1).
         let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut uniform = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut uniform = move || (crate::math::xorshift64(&mut state) >> 40) as f32 / (1u64 << 24) as f32;
         // Mean 0.5, standard deviation 0.2/√3 ≈ 0.115 per pixel.
         let pixels: Vec<[f32; 3]> = (0..count).map(|_| [0.3 + 0.4 * uniform(); 3]).collect();
         let noise = vec![0.4 / 12f32.sqrt(); count];

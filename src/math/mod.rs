@@ -27,6 +27,16 @@ pub use ray::{Ray, gamma, offset_ray_origin};
 
 pub use glam::{DVec2, DVec3};
 
+/// One step of Marsaglia's xorshift64 (shifts 13, 7, 17): the fixed
+/// pseudo-random sequences of unit tests. `state` must not be zero.
+#[cfg(test)]
+pub(crate) fn xorshift64(state: &mut u64) -> u64 {
+    *state ^= *state << 13;
+    *state ^= *state >> 7;
+    *state ^= *state << 17;
+    *state
+}
+
 /// Largest component of a vector.
 pub fn max_component(v: DVec3) -> f64 {
     v.x.max(v.y).max(v.z)

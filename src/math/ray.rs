@@ -143,12 +143,7 @@ mod tests {
     #[test]
     fn offsets_step_exactly_as_next_up_and_next_down() {
         let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut next = move || crate::math::xorshift64(&mut state);
         // Coordinates of every sign and size, exact zeros, and the values
         // whose steps are special (the smallest subnormals, the largest
         // finite numbers, infinities).

@@ -238,7 +238,7 @@ fn polish_root<P: PolynomialPiece>(piece: &P, value_at_0: f64, value_at_1: f64, 
             } else {
                 high - low
             };
-            let claimed = (2.0 * step).max(4.0 * f64::EPSILON).min(high - low);
+            let claimed = claimed_uncertainty(step, (low, high));
             return (
                 tau,
                 confirm_in_noise(piece, tau, claimed, derivative, (low, high), low_is_negative, noise),
@@ -251,7 +251,7 @@ fn polish_root<P: PolynomialPiece>(piece: &P, value_at_0: f64, value_at_1: f64, 
         // Converged: the step is at the rounding level of τ, or the bracket
         // has closed.
         if step <= 2.0 * f64::EPSILON * tau.abs().max(f64::MIN_POSITIVE) || high - low <= 4.0 * f64::EPSILON {
-            let claimed = (2.0 * step).max(4.0 * f64::EPSILON).min(high - low);
+            let claimed = claimed_uncertainty(step, (low, high));
             if !in_noise {
                 return (tau, claimed);
             }
@@ -263,6 +263,12 @@ fn polish_root<P: PolynomialPiece>(piece: &P, value_at_0: f64, value_at_1: f64, 
         }
     }
     (tau, (tau - low).max(high - tau))
+}
+
+/// The uncertainty a Newton step of size `step` claims for its root: twice
+/// the step, at least a few ulps, at most the bracket.
+fn claimed_uncertainty(step: f64, (low, high): (f64, f64)) -> f64 {
+    (2.0 * step).max(4.0 * f64::EPSILON).min(high - low)
 }
 
 /// A certified uncertainty for a root `τ` found where `|p|` is below
@@ -429,12 +435,7 @@ mod tests {
     #[test]
     fn roots_polished_in_the_noise_lie_within_their_uncertainty() {
         let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut uniform = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut uniform = move || (crate::math::xorshift64(&mut state) >> 11) as f64 / (1u64 << 53) as f64;
         let mut cases = vec![(0.3, 3, 8.0, 0.01)];
         for _ in 0..3000 {
             let power = [1, 3, 5][(uniform() * 3.0) as usize % 3];

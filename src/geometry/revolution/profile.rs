@@ -4,6 +4,7 @@
 //! and bounding annulus), its bounding cylinder and its area table, and the
 //! flat discs (caps) that may close its ends.
 
+use super::ray_profile::range;
 use crate::geometry::bezier::MAX_CONTROL_POINTS;
 use crate::math::bernstein;
 use crate::math::gamma;
@@ -74,8 +75,8 @@ impl Arc {
         errors: (f64, f64),
     ) -> Self {
         let (x_error, y_error) = errors;
-        let (x_low, x_high) = hull(&x[..count]);
-        let (y_low, y_high) = hull(&y[..count]);
+        let (x_low, x_high) = range(&x[..count]);
+        let (y_low, y_high) = range(&y[..count]);
         Self {
             t0,
             t1,
@@ -109,13 +110,6 @@ impl Arc {
             Self::new(middle, self.t1, x_right, y_right, count, errors),
         )
     }
-}
-
-/// Smallest and largest of the values.
-fn hull(values: &[f64]) -> (f64, f64) {
-    values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(low, high), &v| {
-        (low.min(v), high.max(v))
-    })
 }
 
 /// A flat disc closing one end of the profile.
