@@ -124,8 +124,7 @@ impl Camera {
         let direction = b.forward + x * b.right + y * b.up;
         let mut ray = if self.has_lens() {
             let focus = self.position + self.focal_distance * direction;
-            let disk = warp::square_to_concentric_disk(lens) * self.aperture_radius;
-            let origin = self.position + disk.x * b.right + disk.y * b.up;
+            let origin = self.lens_point(lens);
             Ray::new(origin, focus - origin)
         } else {
             Ray::new(self.position, direction)
@@ -154,12 +153,7 @@ impl Camera {
     /// §16.1.1 over the lens-sampling pdf, for a box pixel filter).
     pub fn connect(&self, point: DVec3, aspect: f64, lens: DVec2) -> Option<FilmConnection> {
         let b = &self.basis;
-        let lens_point = if self.has_lens() {
-            let disk = warp::square_to_concentric_disk(lens) * self.aperture_radius;
-            self.position + disk.x * b.right + disk.y * b.up
-        } else {
-            self.position
-        };
+        let lens_point = self.lens_point(lens);
         let towards_point = point - lens_point;
         let depth = towards_point.dot(b.forward);
         let distance = towards_point.length();
@@ -180,7 +174,7 @@ impl Camera {
             return None;
         }
         let cos_theta = depth / distance;
-        let film_area = 4.0 * b.tan_half_fov_y * b.tan_half_fov_y * aspect;
+        let film_area = self.film_area(aspect);
         // Camera rays start on the near-clip plane: only the part of the
         // segment beyond it must be clear.
         let clipped = self.near_clip.max(0.0) / cos_theta;
@@ -190,6 +184,32 @@ impl Camera {
             clear_distance: distance - clipped,
             weight: 1.0 / (film_area * cos_theta * cos_theta * cos_theta * distance * distance),
         })
+    }
+
+    /// The point on the aperture that `lens` picks, as
+    /// [`generate_ray`](Self::generate_ray) does (the eye for a pinhole).
+    #[inline]
+    pub fn lens_point(&self, lens: DVec2) -> DVec3 {
+        if self.has_lens() {
+            let disk = warp::square_to_concentric_disk(lens) * self.aperture_radius;
+            self.position + disk.x * self.basis.right + disk.y * self.basis.up
+        } else {
+            self.position
+        }
+    }
+
+    /// Where the line of a camera ray crosses the lens plane: the lens point
+    /// it left from, wherever along it (near clipping) the ray starts.
+    pub fn lens_point_of(&self, ray: &Ray) -> DVec3 {
+        let forward = self.basis.forward;
+        ray.origin - ray.direction * ((ray.origin - self.position).dot(forward) / ray.direction.dot(forward))
+    }
+
+    /// The film's area on the plane at unit distance, for an image of
+    /// `aspect` (width / height): solid angle per unit of film is
+    /// `film_area · cos³θ`.
+    pub fn film_area(&self, aspect: f64) -> f64 {
+        4.0 * self.basis.tan_half_fov_y * self.basis.tan_half_fov_y * aspect
     }
 
     /// Depth of a world point along the view axis: what the focal distance

@@ -187,6 +187,11 @@ impl Lights {
         Some((index as u32, self.probability[index]))
     }
 
+    /// The probability that [`choose`](Self::choose) picks light `index`.
+    pub fn probability(&self, index: u32) -> f64 {
+        self.probability[index as usize]
+    }
+
     /// Samples a point on a light as seen from `reference`.
     pub fn sample(&self, source: &impl EmitterSource, reference: DVec3, u_select: f64, u: DVec2) -> Option<LightSample<'_>> {
         let (index, selection) = self.choose(u_select)?;

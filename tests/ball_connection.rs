@@ -122,6 +122,7 @@ fn luminance_down(loaded: &LoadedScene, light_sampling: bool, origin: impl Fn(u6
         max_depth: 24,
         light_sampling,
         caustics_by_light_paths: false,
+        lens_connections: None,
     };
     let n = 200_000;
     let (mut sum, mut sum_squares) = (0.0, 0.0);

@@ -99,6 +99,7 @@ fn roulette_inside_glass_does_not_inflate_the_weights() {
         max_depth: 8,
         light_sampling: true,
         caustics_by_light_paths: false,
+        lens_connections: None,
     };
     let bound = (1.0 / 0.95_f64).powi(8) * (1.0 + 1e-9);
     let (mut sum, mut largest) = (0.0, 0.0_f64);

@@ -151,15 +151,19 @@ impl BallOptics {
     /// leaving `x` along `direction`: the test that partitions the paths
     /// through the ball between the estimator using `paths` and BSDF sampling.
     pub fn finds(&self, bounce: Bounce, x: DVec3, y: DVec3, direction: DVec3) -> bool {
-        let Some(plane) = self.plane(x, y) else {
-            return false;
-        };
+        self.path_along(bounce, x, y, direction).is_some()
+    }
+
+    /// The path of [`paths`](Self::paths) from `x` to `y` that leaves `x`
+    /// along `direction`, if the scan finds it.
+    pub fn path_along(&self, bounce: Bounce, x: DVec3, y: DVec3, direction: DVec3) -> Option<BallPath> {
+        let plane = self.plane(x, y)?;
         // The impact parameter of `direction`: its distance from the centre
         // over the radius, signed by the side of the line from x to the centre.
         let impact = plane.x_distance * direction.dot(plane.across) / self.radius;
         self.paths(bounce, x, y)
-            .iter()
-            .any(|path| (path.impact - impact).abs() < SAME_PATH)
+            .into_iter()
+            .find(|path| (path.impact - impact).abs() < SAME_PATH)
     }
 
     /// Area on the plane through `y` with normal `normal` per unit solid

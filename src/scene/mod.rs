@@ -17,7 +17,7 @@ pub use error::{Location, SceneError};
 pub use load::{COORDINATE_LIMIT, LoadedScene, load_scene_bytes, load_scene_file, load_scene_str, load_scene_str_edited};
 pub use progress::{LoadStage, load_scene_file_with_progress};
 pub use similarity::{Similarity, load_scene_str_placed};
-pub use specular_balls::SpecularBall;
+pub use specular_balls::{MAX_SPECULAR_BALLS, SpecularBall};
 
 use crate::accel::{BuildPrimitive, Bvh, LeafKind};
 use crate::color::Color;

@@ -78,7 +78,8 @@ pub fn radiance_by_balls<C: Radiance>(
             else {
                 continue;
             };
-            if !unoccluded(scene, hit, &path, !ball.hollow, y, sample.point_error.length()) {
+            let to_ball = Ray::spawn(hit.point, hit.point_error, hit.geometric_normal, path.direction);
+            if !unoccluded(scene, to_ball, &path, !ball.hollow, y, sample.point_error.length()) {
                 continue;
             }
             let surface = match ball.bounce {
@@ -101,7 +102,7 @@ pub fn radiance_by_balls<C: Radiance>(
 /// leg from the ball crosses none of them, so it ends there: smallpt's
 /// light, whose whole sphere is 4400 times the sliver below its ceiling);
 /// otherwise the whole surface. `None` if the area is degenerate.
-fn light_point_seen_by(light: &Light, emitter: &Emitter, ball: &SpecularBall, u: DVec2) -> Option<(AreaSample, f64)> {
+pub(super) fn light_point_seen_by(light: &Light, emitter: &Emitter, ball: &SpecularBall, u: DVec2) -> Option<(AreaSample, f64)> {
     let cap = light
         .clipped
         .as_deref()
@@ -113,11 +114,10 @@ fn light_point_seen_by(light: &Light, emitter: &Emitter, ball: &SpecularBall, u:
     (area > 0.0 && area.is_finite()).then_some((sample, area))
 }
 
-/// Whether nothing blocks the legs of `path`: to the ball, across it (if
-/// it goes through and `across` asks), and from it to `y` (stopping short
-/// of y by its error bound).
-fn unoccluded(scene: &Scene, hit: &SurfaceHit, path: &BallPath, across: bool, y: DVec3, y_error: f64) -> bool {
-    let to_ball = Ray::spawn(hit.point, hit.point_error, hit.geometric_normal, path.direction);
+/// Whether nothing blocks the legs of `path`: `to_ball` (a ray along
+/// its first leg) up to the ball, across it (if it goes through and
+/// `across` asks), and from it to `y` (stopping short of y by its error bound).
+pub(super) fn unoccluded(scene: &Scene, to_ball: Ray, path: &BallPath, across: bool, y: DVec3, y_error: f64) -> bool {
     let to_entry = (path.entry - to_ball.origin).length();
     if scene.occluded(&to_ball, to_entry * (1.0 - SHORTFALL)) {
         return false;

@@ -7,11 +7,13 @@
 pub mod ball_connection;
 pub mod caustic_emission;
 pub mod caustic_paths;
+pub mod lens_connection;
 pub mod tracer;
 
 pub use tracer::PathTracer;
 
 use caustic_emission::CausticEmission;
+use lens_connection::LensView;
 
 use super::{Integrator, RowSet, Share, pass};
 use crate::camera::Camera;
@@ -119,6 +121,11 @@ impl Integrator for PathIntegrator {
         let spectral = self.settings.spectral || scene.has_dispersion();
         let light_traced = caustic_paths_apply(&self.settings) && !spectral && caustic_paths::scene_has_caustics(scene);
         self.tracer.caustics_by_light_paths = light_traced;
+        if self.passes == 0 {
+            let size = (self.film.width, self.film.height);
+            let lens = light_traced && lens_connection::scene_has_lens_connections(scene);
+            self.tracer.lens_connections = lens.then(|| LensView::new(scene, camera, size));
+        }
         if light_traced {
             let pixels = self.settings.sampled_pixels();
             let film = &mut self.film;
@@ -135,7 +142,8 @@ impl Integrator for PathIntegrator {
             let rows = self.rows;
             let share_pixels = |x: u32, y: u32| pixels.contains(x, y) && rows.contains(y);
             let light = (&*emission, self.settings.max_depth);
-            if !caustic_paths::add_pass(film, scene, camera, light, share_pixels, stream, cancel) {
+            let lens = self.tracer.lens_connections.as_ref();
+            if !caustic_paths::add_pass(film, scene, camera, light, lens, share_pixels, stream, cancel) {
                 return false;
             }
         }

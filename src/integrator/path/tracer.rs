@@ -6,7 +6,9 @@
 //! This file is the per-sample tracer; [`super`] drives it over the film.
 
 use super::ball_connection::{Departure, Passage, radiance_by_balls};
+use super::lens_connection::LensView;
 use crate::color::Color;
+use crate::geometry::{Bounce, SurfaceHit};
 use crate::material::{ShadingPoint, Transport};
 use crate::math::{Frame as ShadingFrame, Ray, warp::power_heuristic};
 use crate::sampler::Sampler;
@@ -30,6 +32,10 @@ pub struct PathTracer {
     /// emission of a shape light reached through a specular surface after
     /// a non-specular first surface (see [`super::caustic_paths`]).
     pub caustics_by_light_paths: bool,
+    /// Lights seen in mirror balls are also reached by lens connections
+    /// ([`super::lens_connection`]): weight emission found by a camera ray
+    /// reflected off a mirror ball by the camera's share.
+    pub lens_connections: Option<LensView>,
 }
 
 impl PathTracer {
@@ -40,6 +46,7 @@ impl PathTracer {
             max_depth: settings.max_depth,
             light_sampling: settings.integrator != IntegratorKind::BsdfOnly,
             caustics_by_light_paths: false,
+            lens_connections: None,
         }
     }
 
@@ -105,6 +112,9 @@ impl PathTracer {
         let mut specular_chain = true;
         // The surface the current ray leaves, which it cannot hit again.
         let mut leaving = Leaving::Nothing;
+        // The mirror ball the camera ray reflected off, and that ray, while
+        // lens connections may reach what it finds next.
+        let mut off_ball_from_lens: Option<(usize, Ray)> = None;
 
         for bounce in 0.. {
             let Some(intersection) = scene.intersect_leaving(&ray, f64::INFINITY, leaving) else {
@@ -126,6 +136,7 @@ impl PathTracer {
                             .pdf(scene, light, previous_point, hit.point, hit.geometric_normal);
                         power_heuristic(previous_pdf, light_pdf)
                     }
+                    Some(light) if balls && bounce == 1 => self.camera_share(scene, off_ball_from_lens, light, &hit),
                     _ => 1.0,
                 };
                 radiance += throughput * C::emission(emitted, wavelengths) * weight;
@@ -135,6 +146,13 @@ impl PathTracer {
             }
             if bounce == 0 {
                 first_surface_not_specular = !material.is_specular();
+                if balls && self.lens_connections.is_some() {
+                    let off_ball = scene
+                        .specular_balls()
+                        .iter()
+                        .position(|ball| ball.primitive == intersection.primitive && ball.bounce == Bounce::Off);
+                    off_ball_from_lens = off_ball.map(|ball| (ball, ray));
+                }
             }
 
             let here = scene.leaving(intersection.primitive);
@@ -229,5 +247,22 @@ impl PathTracer {
             }
         }
         radiance
+    }
+
+    /// The weight of emission from `light` found at `hit` by a camera ray
+    /// that reflected off the mirror ball `off_ball` (with the camera ray),
+    /// against the lens connections; 1 for every other path.
+    fn camera_share(&self, scene: &Scene, off_ball: Option<(usize, Ray)>, light: u32, hit: &SurfaceHit) -> f64 {
+        match (&self.lens_connections, off_ball) {
+            (Some(view), Some((ball, ray))) => view.camera_share(
+                scene,
+                &scene.specular_balls()[ball],
+                &ray,
+                light,
+                hit.point,
+                hit.geometric_normal,
+            ),
+            _ => 1.0,
+        }
     }
 }
