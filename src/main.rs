@@ -104,8 +104,9 @@ struct RenderArgs {
     #[arg(long)]
     spectral: bool,
     /// Path tracing: trace caustics (light focused by mirrors and glass onto
-    /// what the camera sees) from the lights and connect them to the lens
-    /// (`true`, the default), or leave them to camera paths (`false`).
+    /// what the camera sees) from the lights and connect them to the lens,
+    /// and reach lights seen in mirror balls from the lens too (`true`, the
+    /// default), or leave them to camera paths (`false`).
     #[arg(long, value_name = "true|false")]
     caustic_light_paths: Option<bool>,
     /// SPPM: photons traced per iteration.

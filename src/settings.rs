@@ -91,7 +91,8 @@ pub struct RenderSettings {
     /// Path tracing: trace caustics (light focused by mirrors and glass onto
     /// the surfaces the camera sees) from the lights and connect them to the
     /// lens, rather than waiting for camera paths to hit the light through
-    /// the glass (`integrator::path::caustic_paths`).
+    /// the glass (`integrator::path::caustic_paths`); and reach lights seen
+    /// in mirror balls from the lens as well (`integrator::path::lens_connection`).
     pub caustic_light_paths: bool,
 }
 
