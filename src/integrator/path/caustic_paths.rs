@@ -83,7 +83,8 @@ pub fn paths_per_pass(pixels: usize) -> u64 {
 /// (i, `sample_index`)), and adds their connections to the lens that
 /// land on pixels (x, y) where `keep(x, y)` to `film.light` (nothing if it
 /// is `None`); with `lens`, lens connections off mirror balls
-/// ([`LensView::connect`]) too, one per [`LIGHT_PATHS_PER_LENS_CONNECTION`]. False if cancelled, leaving the film unchanged.
+/// ([`LensView::connect`]) too, one per [`LIGHT_PATHS_PER_LENS_CONNECTION`]
+/// light paths. False if cancelled, leaving the film unchanged.
 #[allow(clippy::too_many_arguments)]
 pub fn add_pass(
     film: &mut Film,
