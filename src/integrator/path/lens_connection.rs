@@ -137,6 +137,10 @@ impl LensView {
         self.width as f64 / self.height as f64
     }
 
+    fn pixel_count(&self) -> f64 {
+        self.width as f64 * self.height as f64
+    }
+
     /// The light `u_select` chooses, with its probability, unless it is clipped.
     fn light<'a>(&self, scene: &'a Scene, u_select: f64) -> Option<(&'a Light, f64)> {
         let (index, selection) = scene.lights.choose(u_select)?;
@@ -152,7 +156,7 @@ impl LensView {
         // Splats per unit of film (the film being 1 × 1) from one lens
         // point: the light's image there covers the pixel count over that.
         let film_density = area_pdf * spread * self.camera.film_area(self.aspect()) * cos * cos * cos;
-        let image = (self.width as f64 * self.height as f64) / film_density;
+        let image = self.pixel_count() / film_density;
         // Camera rays find the image in a pixel as often as the image
         // covers the pixel and the blur around it.
         let relative = image / (1.0 + self.blur_pixels(path.entry));
@@ -171,10 +175,9 @@ impl LensView {
         let depth = camera.depth_of(point);
         let focal = camera.focal_distance;
         let radius = camera.aperture_radius * (depth - focal).abs() / depth;
-        // The film spans 2 f tan(fov/2) of the focal plane vertically.
-        let tan_half_fov = (camera.film_area(self.aspect()) / (4.0 * self.aspect())).sqrt();
-        let pixel = 2.0 * focal * tan_half_fov / self.height as f64;
-        std::f64::consts::PI * (radius / pixel).powi(2)
+        // The film covers f² · A_film of the focal plane.
+        let pixel_area = focal * focal * camera.film_area(self.aspect()) / self.pixel_count();
+        std::f64::consts::PI * radius * radius / pixel_area
     }
 
     /// The camera ray's share of emission from `light` found at `y`
@@ -232,10 +235,9 @@ impl LensView {
             // weight is per unit area at the ball.
             let distance = (path.entry - x).length();
             let importance = film.weight * distance * distance;
-            let pixel_count = self.width as f64 * self.height as f64;
             each(Candidate {
                 share: self.connection_share(&path, spread, area_pdf),
-                weight: importance * pixel_count / (spread * area_pdf),
+                weight: importance * self.pixel_count() / (spread * area_pdf),
                 path,
                 film,
                 light_point,
@@ -296,6 +298,8 @@ impl LensView {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::color::luminance;
+    use crate::film::PixelAccumulator;
     use crate::integrator::path::PathTracer;
     use crate::sampler::SamplerKind;
     use crate::scene::load_scene_str;
@@ -329,12 +333,6 @@ mod tests {
         material = "lamp"
     "#;
 
-    /// Mean and standard error of the film-wide mean of `count` values.
-    fn mean_and_error(sum: Color, squares: f64, count: f64) -> (f64, f64) {
-        let mean = crate::color::luminance(sum) / count;
-        (mean, ((squares / count - mean * mean) / count).max(0.0).sqrt())
-    }
-
     /// The camera rays' share of the paths lens → mirror ball → light plus
     /// the lens connections equals, in the mean over the film, what the
     /// camera rays find counting every such path in full: the weights sum
@@ -350,9 +348,10 @@ mod tests {
         let ball = scene.specular_balls()[0];
 
         // Camera rays, film and lens uniform: emission met right after the
-        // ball, in full (`all`) and weighted by the camera's share (`kept`).
+        // ball, in full (`all`) and weighted by the camera's share (`kept`),
+        // zero for the other rays.
         let rays = 1_000_000;
-        let (mut all, mut all_squares, mut kept, mut kept_squares) = (Color::ZERO, 0.0, Color::ZERO, 0.0);
+        let (mut all, mut kept) = (PixelAccumulator::default(), PixelAccumulator::default());
         let mut random = Sampler::new(SamplerKind::Random, 0, 0, 17);
         let tracer = PathTracer {
             max_depth: 4,
@@ -360,48 +359,45 @@ mod tests {
             caustics_by_light_paths: true,
             lens_connections: Some(view),
         };
-        for _ in 0..rays {
-            let (film, lens) = (random.next_2d(), random.next_2d());
-            let ray = camera.generate_ray(film, 1.0, lens);
-            let Some(first) = scene.intersect(&ray, f64::INFINITY) else {
-                continue;
-            };
-            if first.primitive != ball.primitive {
-                continue;
-            }
+        // The emission a camera ray meets right after reflecting off the
+        // ball, and the camera's share of it.
+        let off_ball = |ray: &Ray| -> Option<(Color, f64)> {
+            let first = scene
+                .intersect(ray, f64::INFINITY)
+                .filter(|first| first.primitive == ball.primitive)?;
             let normal = first.hit.geometric_normal;
             let reflected = ray.direction - 2.0 * ray.direction.dot(normal) * normal;
             let bounce = Ray::spawn(first.hit.point, first.hit.point_error, normal, reflected);
-            let Some(second) = scene.intersect(&bounce, f64::INFINITY) else {
-                continue;
-            };
-            let Some(light) = scene.lights.light_of_primitive(second.primitive) else {
-                continue;
-            };
+            let second = scene.intersect(&bounce, f64::INFINITY)?;
+            let light = scene.lights.light_of_primitive(second.primitive)?;
             let value = scene.lights.lights[light as usize].radiance * ball.tint;
-            let share = view.camera_share(&scene, &ball, &ray, light, second.hit.point, second.hit.geometric_normal);
-            assert!((0.0..=1.0).contains(&share), "{share}");
-            // The path tracer, told of the connections, weights the same.
-            let traced = tracer.radiance(&scene, ray, &mut random.clone());
-            assert!(
-                (traced - value * share).length() <= 1e-9 * value.length(),
-                "{traced} vs {}",
-                value * share
-            );
-            all += value;
-            all_squares += crate::color::luminance(value).powi(2);
-            kept += value * share;
-            kept_squares += (crate::color::luminance(value) * share).powi(2);
+            let share = view.camera_share(&scene, &ball, ray, light, second.hit.point, second.hit.geometric_normal);
+            Some((value, share))
+        };
+        for _ in 0..rays {
+            let (film, lens) = (random.next_2d(), random.next_2d());
+            let ray = camera.generate_ray(film, 1.0, lens);
+            let (value, share) = off_ball(&ray).unwrap_or((Color::ZERO, 0.0));
+            if value != Color::ZERO {
+                assert!((0.0..=1.0).contains(&share), "{share}");
+                // The path tracer, told of the connections, weights the same.
+                let traced = tracer.radiance(&scene, ray, &mut random.clone());
+                assert!(
+                    (traced - value * share).length() <= 1e-9 * value.length(),
+                    "{traced} vs {}",
+                    value * share
+                );
+            }
+            all.add(value);
+            kept.add(value * share);
         }
-        let (all, all_error) = mean_and_error(all, all_squares, rays as f64);
-        let (kept, kept_error) = mean_and_error(kept, kept_squares, rays as f64);
 
         // Lens connections: each splat is a pixel's value for one connection
         // per image, so the film-wide mean is the splats' sum over the pixel
         // count, per connection.
         let connections = 100_000;
         let pixels = (width * height) as f64;
-        let (mut splatted, mut splatted_squares) = (Color::ZERO, 0.0);
+        let mut splatted = PixelAccumulator::default();
         let mut landed = 0;
         for index in 0..connections {
             let mut sampler = Sampler::new(SamplerKind::Random, index, 0, 5);
@@ -411,10 +407,11 @@ mod tests {
                 this += value / pixels;
                 landed += 1;
             });
-            splatted += this;
-            splatted_squares += crate::color::luminance(this).powi(2);
+            splatted.add(this);
         }
-        let (splatted, splatted_error) = mean_and_error(splatted, splatted_squares, connections as f64);
+        let mean_and_error = |tally: &PixelAccumulator| (luminance(tally.mean()), tally.standard_error());
+        let ((all, all_error), (kept, kept_error)) = (mean_and_error(&all), mean_and_error(&kept));
+        let (splatted, splatted_error) = mean_and_error(&splatted);
 
         // Both strategies matter here, so a wrong weight on either side shows.
         assert!(landed > 1000, "{landed} connections landed");
