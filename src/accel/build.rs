@@ -17,9 +17,13 @@
 //! bounds the depth for any input.
 //!
 //! Speed (the builder should be no slower than Embree's): item boxes are
-//! four-lane arrays (x, y, z and a zero pad), so unions, centroids and bin
-//! indices are single vector operations; a node's bounds and its centroids'
+//! four-lane arrays (x, y, z and a fourth lane that carries the item's
+//! index and kind), so unions, centroids and bin indices are single vector
+//! operations and an item is 32 bytes; a node's bounds and its centroids'
 //! bounds come from its parent's partition pass instead of new passes.
+//! Near the root the passes stream every item through memory, so their
+//! cost is the items' size; further down it is the binning's chains of
+//! updates to one bin, which two sets of bins halve.
 //!
 //! Bounds are single precision, rounded outward from the primitives' own
 //! double-precision boxes, so a box can only be larger than what it holds.
@@ -68,8 +72,9 @@ impl LeafKind {
     }
 }
 
-/// A box as two four-lane vectors; lane 3 is zero.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// A box as two four-lane vectors: x, y and z in lanes 0–2. Lane 3 means
+/// nothing (items carry their index and kind there); nothing reads it.
+#[derive(Clone, Copy, Debug)]
 pub struct Box4 {
     /// Lower corner in lanes 0–2 (x, y, z).
     pub lower: f32x4,
@@ -83,15 +88,6 @@ impl Box4 {
         lower: f32x4::new([f32::INFINITY, f32::INFINITY, f32::INFINITY, 0.0]),
         upper: f32x4::new([f32::NEG_INFINITY, f32::NEG_INFINITY, f32::NEG_INFINITY, 0.0]),
     };
-
-    fn from_bounds(bounds: &Bounds32) -> Self {
-        let [x0, y0, z0] = bounds.min;
-        let [x1, y1, z1] = bounds.max;
-        Self {
-            lower: f32x4::new([x0, y0, z0, 0.0]),
-            upper: f32x4::new([x1, y1, z1, 0.0]),
-        }
-    }
 
     /// The same box as three-component [`Bounds32`].
     pub fn to_bounds(self) -> Bounds32 {
@@ -143,33 +139,60 @@ impl Box4 {
     }
 }
 
-/// One primitive as the builder sees it.
+/// One primitive as the builder sees it: its box, with its index in the
+/// lower corner's lane 3 and its kind in the upper corner's (as the bits of
+/// those lanes), so an item is 32 bytes, two thirds of a separate record's
+/// 48, and the passes near the root, which stream every item through
+/// memory, move a third less. Every use of a box reads lanes 0–2 only.
 #[derive(Clone, Copy, Debug)]
 pub struct BuildItem {
-    /// The primitive's outward-rounded bounds.
-    pub bounds: Box4,
-    /// Index into the caller's primitives.
-    pub index: u32,
-    /// Primitives of different kinds never share a leaf.
-    pub kind: u32,
+    /// The primitive's outward-rounded bounds (lanes 0–2), index and kind (lane 3).
+    bounds: Box4,
 }
 
 impl BuildItem {
     /// An item for primitive `index` of leaf kind `kind`, with bounds `bounds`.
     pub fn new(bounds: Bounds32, index: u32, kind: u8) -> Self {
+        debug_assert!(index < MAX_ITEMS as u32);
+        let [x0, y0, z0] = bounds.min;
+        let [x1, y1, z1] = bounds.max;
         Self {
-            bounds: Box4::from_bounds(&bounds),
-            index,
-            kind: u32::from(kind),
+            bounds: Box4 {
+                lower: f32x4::new([x0, y0, z0, f32::from_bits(LANE3_OFFSET + index)]),
+                upper: f32x4::new([x1, y1, z1, f32::from_bits(LANE3_OFFSET + u32::from(kind))]),
+            },
         }
     }
 
+    /// Index into the caller's primitives.
+    #[inline(always)]
+    pub fn index(&self) -> u32 {
+        self.bounds.lower.to_array()[3].to_bits() - LANE3_OFFSET
+    }
+
+    /// Primitives of different kinds never share a leaf.
+    #[inline(always)]
+    pub fn kind(&self) -> u32 {
+        self.bounds.upper.to_array()[3].to_bits() - LANE3_OFFSET
+    }
+
     /// Twice the box centre (lower + upper): no multiplication needed.
+    /// (Lane 3 is meaningless.)
     #[inline(always)]
     fn centroid2(&self) -> f32x4 {
         self.bounds.lower + self.bounds.upper
     }
 }
+
+/// Most items a build takes: three kinds of at most 2²⁷ primitives each
+/// (what a BVH's leaf references can index) fit.
+pub const MAX_ITEMS: usize = 1 << 29;
+
+/// Added to the index and kind before they are stored as lane 3's bits:
+/// the lane then holds a normal float (2 to about 10¹⁹ for any index below
+/// 2²⁹), never a subnormal, which some processors handle slowly in the
+/// arithmetic the other lanes need.
+const LANE3_OFFSET: u32 = 0x4000_0000;
 
 /// A node of the binary tree, in depth-first order (the left child follows
 /// its parent).
@@ -237,7 +260,7 @@ fn build_into(items: &mut [BuildItem], range: &Range, kinds: &[LeafKind], nodes:
             content: BinaryContent::Leaf {
                 first: range.first as u32,
                 count: items.len() as u32,
-                kind: items[0].kind as u8,
+                kind: items[0].kind() as u8,
             },
         });
         return;
@@ -283,9 +306,9 @@ fn choose_split(items: &mut [BuildItem], range: &Range, kinds: &[LeafKind]) -> O
         // is a leaf, since a split costs C_trav + (A_L + A_R) / A ≥ 1 block
         // (areas are never negative), no less than the leaf's one block
         // (unless a block of its kind costs more than a traversal step).
-        let first_kind = items[0].kind;
-        if !items.iter().all(|item| item.kind == first_kind) {
-            return Some(partition(items, range, |item| item.kind == first_kind));
+        let first_kind = items[0].kind();
+        if !items.iter().all(|item| item.kind() == first_kind) {
+            return Some(partition(items, range, |item| item.kind() == first_kind));
         }
         if count <= block_size(first_kind, kinds) as usize {
             return split_costly_block(items, range, leaf_kind(first_kind, kinds));
@@ -299,9 +322,8 @@ fn choose_split(items: &mut [BuildItem], range: &Range, kinds: &[LeafKind]) -> O
         return Some(median_split(items, range, extent));
     }
     let binning = Binning::new(range, extent);
-    let mut bins = Bins::EMPTY;
-    binning.bin(items, &mut bins);
-    let block_shift = block_size(items[0].kind, kinds).trailing_zeros();
+    let bins = binning.bin(items);
+    let block_shift = block_size(items[0].kind(), kinds).trailing_zeros();
     let Some((axis, plane, _)) = bins.cheapest_plane(count, block_shift) else {
         return Some(median_split(items, range, extent));
     };
@@ -319,8 +341,7 @@ fn split_costly_block(items: &mut [BuildItem], range: &Range, kind: LeafKind) ->
         return None;
     }
     let binning = Binning::new(range, extent);
-    let mut bins = Bins::EMPTY;
-    binning.bin(items, &mut bins);
+    let bins = binning.bin(items);
     let block_shift = kind.max_size.clamp(1, MAX_LEAF_SIZE).ilog2();
     let (axis, plane, split_areas) = bins.cheapest_plane(items.len(), block_shift)?;
     let area = range.bounds.half_area();
@@ -362,22 +383,50 @@ impl Binning {
             .to_array()
     }
 
-    /// Bins every item along the three axes at once.
+    /// Bins every item along the three axes at once. Neighbouring items
+    /// (neighbouring in a mesh, so in space) often fall in the same bin,
+    /// and each update of a bin waits for the previous one to be stored;
+    /// alternate items go to two sets of bins, merged at the end, so two
+    /// such chains run side by side.
     // Out of line (as are the sweep and the partition), so that profiles
     // show the builder's three phases apart.
     #[inline(never)]
-    fn bin(&self, items: &[BuildItem], bins: &mut Bins) {
-        for item in items {
-            let bin = self.bins_of(item);
-            for axis in 0..3 {
-                // The mask only tells the compiler the index is in range (it is).
-                let bin = bin[axis] as usize & (BIN_COUNT - 1);
-                bins.bounds[bin][axis] = bins.bounds[bin][axis].union(&item.bounds);
-                bins.counts[bin][axis] += 1;
+    fn bin(&self, items: &[BuildItem]) -> Bins {
+        let mut even = Bins::EMPTY;
+        if items.len() < PAIRED_BINNING_MIN {
+            for item in items {
+                self.add(item, &mut even);
             }
+            return even;
+        }
+        let mut odd = Bins::EMPTY;
+        let mut pairs = items.chunks_exact(2);
+        for pair in &mut pairs {
+            self.add(&pair[0], &mut even);
+            self.add(&pair[1], &mut odd);
+        }
+        for item in pairs.remainder() {
+            self.add(item, &mut even);
+        }
+        even.merge(&odd);
+        even
+    }
+
+    #[inline(always)]
+    fn add(&self, item: &BuildItem, bins: &mut Bins) {
+        let bin = self.bins_of(item);
+        for axis in 0..3 {
+            // The mask only tells the compiler the index is in range (it is).
+            let bin = bin[axis] as usize & (BIN_COUNT - 1);
+            bins.bounds[bin][axis] = bins.bounds[bin][axis].union(&item.bounds);
+            bins.counts[bin][axis] += 1;
         }
     }
 }
+
+/// Ranges at least this long are binned into two sets of bins (merging
+/// them costs about as much as binning this many items).
+const PAIRED_BINNING_MIN: usize = 64;
 
 const _: () = assert!(BIN_COUNT.is_power_of_two());
 
@@ -394,6 +443,16 @@ impl Bins {
         bounds: [[Box4::EMPTY; 3]; BIN_COUNT],
         counts: [[0; 4]; BIN_COUNT],
     };
+
+    /// Adds `other`'s items to these bins.
+    fn merge(&mut self, other: &Bins) {
+        for bin in 0..BIN_COUNT {
+            for axis in 0..3 {
+                self.bounds[bin][axis] = self.bounds[bin][axis].union(&other.bounds[bin][axis]);
+                self.counts[bin][axis] += other.counts[bin][axis];
+            }
+        }
+    }
 
     /// The axis and plane (items in bins below `plane` go left) of least
     /// SAH cost A_L ⌈N_L/b⌉ + A_R ⌈N_R/b⌉ (b = 2^`block_shift`) among
@@ -503,19 +562,36 @@ fn largest_axis(extent: [f32; 3]) -> usize {
 fn partition(items: &mut [BuildItem], range: &Range, goes_left: impl Fn(&BuildItem) -> bool) -> (usize, Range, Range) {
     let (mut left_bounds, mut left_centroids) = (Box4::EMPTY, Box4::EMPTY);
     let (mut right_bounds, mut right_centroids) = (Box4::EMPTY, Box4::EMPTY);
-    let mut split = 0;
-    for i in 0..items.len() {
-        let item = items[i];
+    // Hoare's scheme: items before `split` go left, items from `end` on go
+    // right; only an item found on the wrong side is moved, swapped with
+    // one found on the wrong side from the other end.
+    let (mut split, mut end) = (0, items.len());
+    'scan: while split < end {
+        let item = items[split];
         if goes_left(&item) {
             left_bounds = left_bounds.union(&item.bounds);
             left_centroids = left_centroids.include(item.centroid2());
-            // A swap of items `i` and `split`, reusing the copy in registers.
-            items[i] = items[split];
-            items[split] = item;
             split += 1;
-        } else {
-            right_bounds = right_bounds.union(&item.bounds);
-            right_centroids = right_centroids.include(item.centroid2());
+            continue;
+        }
+        right_bounds = right_bounds.union(&item.bounds);
+        right_centroids = right_centroids.include(item.centroid2());
+        loop {
+            end -= 1;
+            if end == split {
+                break 'scan;
+            }
+            let other = items[end];
+            if goes_left(&other) {
+                left_bounds = left_bounds.union(&other.bounds);
+                left_centroids = left_centroids.include(other.centroid2());
+                items[split] = other;
+                items[end] = item;
+                split += 1;
+                break;
+            }
+            right_bounds = right_bounds.union(&other.bounds);
+            right_centroids = right_centroids.include(other.centroid2());
         }
     }
     let depth = range.depth + 1;
@@ -597,9 +673,9 @@ mod tests {
             if let BinaryContent::Leaf { first, count, kind } = node.content {
                 assert!(count as usize <= leaf_sizes[kind as usize] && count > 0);
                 for item in &items[first as usize..(first + count) as usize] {
-                    assert_eq!(item.kind, u32::from(kind));
+                    assert_eq!(item.kind(), u32::from(kind));
                     assert!(contains(&node.bounds, &item.bounds));
-                    seen[item.index as usize] += 1;
+                    seen[item.index() as usize] += 1;
                 }
             }
         }
@@ -617,6 +693,21 @@ mod tests {
                 assert_eq!(after_left, right as usize);
                 check_nesting(nodes, right as usize)
             }
+        }
+    }
+
+    /// An item gives back its index and kind, for the smallest and largest
+    /// of each, and its fourth lanes hold normal floats (see `LANE3_OFFSET`).
+    #[test]
+    fn items_carry_index_and_kind_in_normal_floats() {
+        for (index, kind) in [(0, 0), (1, 2), (MAX_ITEMS as u32 - 1, 2), (12345, 1)] {
+            let item = item([-1.0, 0.0, 1.0], [2.0, 3.0, 4.0], index, kind);
+            assert_eq!((item.index(), item.kind()), (index, u32::from(kind)));
+            for lane in [item.bounds.lower.to_array()[3], item.bounds.upper.to_array()[3]] {
+                assert!(lane.is_normal(), "{lane:e}");
+            }
+            let bounds = item.bounds.to_bounds();
+            assert_eq!((bounds.min, bounds.max), ([-1.0, 0.0, 1.0], [2.0, 3.0, 4.0]));
         }
     }
 

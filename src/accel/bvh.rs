@@ -39,6 +39,7 @@ const COUNT_SHIFT: u32 = 27;
 const FIRST_MASK: u32 = (1 << COUNT_SHIFT) - 1;
 /// Most primitives of one kind a BVH can index.
 pub const MAX_PRIMITIVES_PER_KIND: usize = 1 << COUNT_SHIFT;
+const _: () = assert!(KIND_COUNT * MAX_PRIMITIVES_PER_KIND <= build::MAX_ITEMS);
 /// An unused child slot (its box is empty, so no ray enters it).
 const EMPTY_CHILD: u32 = u32::MAX;
 
@@ -164,9 +165,9 @@ impl Bvh {
         let mut orders: [Vec<u32>; KIND_COUNT] = Default::default();
         let mut index_within_kind = Vec::with_capacity(items.len());
         for item in &items {
-            let order = &mut orders[item.kind as usize];
+            let order = &mut orders[item.kind() as usize];
             index_within_kind.push(order.len() as u32);
-            order.push(item.index);
+            order.push(item.index());
         }
 
         let mut collapser = Collapser {
