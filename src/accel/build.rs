@@ -1,7 +1,7 @@
 //! The binned surface area heuristic builder (Wald 2007, "On fast
 //! construction of SAH-based bounding volume hierarchies"): a binary tree,
 //! O(n log n), with the split strategy separate from the tree it feeds
-//! (`bvh.rs` collapses it into four-wide nodes).
+//! (`bvh.rs` collapses it into eight-wide nodes).
 //!
 //! Items are binned along all three axes at once and the plane of least
 //! SAH cost C = C_trav + (A_L ⌈N_L/4⌉ + A_R ⌈N_R/4⌉) / A (in units of one
@@ -35,8 +35,8 @@ use wide::{CmpGt, CmpLt, f32x4, i32x4};
 const BIN_COUNT: usize = 16;
 /// Subtrees larger than this are built on two threads.
 const PARALLEL_THRESHOLD: usize = 8192;
-/// Cost of one traversal step in units of one leaf test. A four-wide node
-/// tests four boxes at once and a triangle leaf tests its up to four
+/// Cost of one traversal step in units of one leaf test. A wide node
+/// tests its boxes at once and a triangle leaf tests its up to four
 /// triangles at once, at about the same cost, so a leaf's cost is its
 /// number of *blocks* (primitives tested together; see [`blocks`]), and
 /// splitting a range that fits one block never pays: leaves come out full.

@@ -1,4 +1,4 @@
-//! Which binary nodes become four-wide nodes: the collapse of the binned
+//! Which binary nodes become eight-wide nodes: the collapse of the binned
 //! SAH tree ([`super::build`]) that minimises the SAH cost of the wide
 //! tree, found exactly by dynamic programming over the binary tree
 //! (Pinto 2010, "Fast and efficient collapsing of binary BVHs"; Ylitie et
@@ -9,11 +9,11 @@
 //! cost is fixed and the cost left to minimise is the sum, over the wide
 //! nodes, of their surface areas (each one traversal step, in units of the
 //! root's area). A binary interior node either becomes a wide node (one
-//! child slot of its parent, its own four slots below it) or is opened
+//! child slot of its parent, its own eight slots below it) or is opened
 //! (its two subtrees take the parent's slots). Opening where slots allow
 //! is what fills nodes: a greedy top-down collapse that always opens the
 //! largest child leaves slots empty that a better choice higher up would
-//! have used, and every wide node saved is 128 bytes and one box test.
+//! have used, and every wide node saved is 256 bytes and one box test.
 
 use super::build::{BinaryContent, BinaryNode};
 use super::bvh::WIDTH;
@@ -158,7 +158,7 @@ mod tests {
     }
 
     /// The top-down greedy collapse: open the widest interior child until
-    /// the node has four.
+    /// the node has eight.
     fn greedy_children(binary: &[BinaryNode], index: usize) -> ArrayVec<usize, WIDTH> {
         let mut children = ArrayVec::new();
         if let BinaryContent::Interior { right } = binary[index].content {
@@ -183,7 +183,7 @@ mod tests {
     }
 
     /// Least cost of the wide node for `index` by trying every frontier of
-    /// at most four slots below it (exhaustive, unlike the table).
+    /// at most eight slots below it (exhaustive, unlike the table).
     fn exhaustive(binary: &[BinaryNode], index: usize) -> f64 {
         fn frontiers(binary: &[BinaryNode], index: usize, most: usize) -> Vec<Vec<usize>> {
             let mut all = vec![vec![index]];

@@ -3,8 +3,8 @@
 //! caller's closure.
 //!
 //! - [`build`]: the binned-SAH binary tree builder;
-//! - [`collapse`]: which binary nodes become four-wide nodes;
-//! - [`bvh`]: the four-wide tree collapsed from it, and its traversal;
+//! - [`collapse`]: which binary nodes become eight-wide nodes;
+//! - [`bvh`]: the eight-wide tree collapsed from it, and its traversal;
 //! - [`bounds`]: the outward-rounded single-precision boxes both use.
 
 pub mod bounds;

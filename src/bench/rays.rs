@@ -142,7 +142,7 @@ pub struct BuildRow {
     pub build_ms_one_thread: f64,
     /// As `build_ms_one_thread`, on two threads.
     pub build_ms_two_threads: f64,
-    /// Four-wide nodes of the BVH.
+    /// Eight-wide nodes of the BVH.
     pub nodes: usize,
     /// Leaves of the BVH.
     pub leaves: usize,

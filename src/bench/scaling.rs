@@ -76,7 +76,7 @@ pub fn orient_outward(mesh: &mut Mesh, inside: DVec3) {
 pub struct BvhRow {
     /// Triangles in the tessellated sphere.
     pub triangles: usize,
-    /// Four-wide nodes of its BVH.
+    /// Eight-wide nodes of its BVH.
     pub nodes: usize,
     /// Mean of repeated single-threaded builds, in thread CPU time where
     /// known (else wall time), which other load barely disturbs.
