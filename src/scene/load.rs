@@ -10,6 +10,7 @@ use super::document::{Document, FieldPath};
 use super::error::{Location, SceneError};
 use super::progress::LoadStage;
 use super::{Primitive, Scene};
+use crate::accel::bvh::MAX_PRIMITIVES_PER_KIND;
 use crate::camera::Camera;
 use crate::color::Color;
 use crate::geometry::{AxisBox, Mesh, Quad, Revolution, Shape, Sphere, Transform};
@@ -224,6 +225,16 @@ impl Builder<'_> {
                 images: &mut images,
             };
             self.object(&path, object, material, &mut scene)?;
+            if primitives.len() > MAX_PRIMITIVES_PER_KIND {
+                return Err(self.error(
+                    &path,
+                    format!(
+                        "the objects up to this one hold {} primitives (a mesh counts its triangles); \
+                         the BVH indexes at most {MAX_PRIMITIVES_PER_KIND}",
+                        primitives.len()
+                    ),
+                ));
+            }
         }
 
         let background = match description.background {
