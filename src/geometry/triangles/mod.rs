@@ -22,10 +22,12 @@
 //! four lanes ([`lanes`] tests them together); lanes past n read the next
 //! coordinates (or, at the end, padding) and are masked off. The test
 //! takes a leaf as one fixed 36-float window from `9f`, so its nine loads
-//! need no bounds checks of their own. Per triangle there is also one
-//! 32-bit word with its mesh (for the anchor) and its lane and leaf size
-//! (to find its offsets again), and the cold face and material: 48 bytes
-//! per triangle in all.
+//! need no bounds checks of their own. Per triangle there is also a
+//! 12-byte record: a word with its mesh (for the anchor) and its lane and
+//! leaf size (to find its offsets again), its face and its material, 48
+//! bytes per triangle in all. The record is one piece because the final
+//! hit needs all three, and on a mesh too large for the caches each
+//! separate array read cost the hit a cache miss of its own.
 
 mod lanes;
 
@@ -59,12 +61,14 @@ const LEAF_FLOATS: usize = 36;
 /// Zeros after the last offset: a one-triangle leaf at the end reads 27
 /// floats past its nine.
 const OFFSET_PADDING: usize = LEAF_FLOATS - 9;
-/// Zeros after the last placement word: a leaf's four lanes read four words.
-const PLACEMENT_PADDING: usize = 3;
+/// Zero records after the last one: a leaf's four lanes read four placement words.
+const RECORD_PADDING: usize = 3;
 
-/// What only the final hit needs.
-#[derive(Clone, Copy, Debug)]
-struct ColdData {
+/// A triangle's record (see the module doc).
+#[derive(Clone, Copy, Debug, Default)]
+struct Record {
+    /// Mesh, lane and leaf size (see [`MESH_BITS`]).
+    placement: u32,
     face: u32,
     material: u32,
 }
@@ -75,9 +79,10 @@ pub struct Triangles {
     /// Vertex offsets from the mesh anchors, leaf by leaf as
     /// structure-of-arrays (see the module doc), then [`OFFSET_PADDING`] zeros.
     offsets: Vec<f32>,
-    /// Per triangle: mesh, lane and leaf size (see [`MESH_BITS`]), then [`PLACEMENT_PADDING`] zeros.
-    placement: Vec<u32>,
-    cold: Vec<ColdData>,
+    /// Per triangle, then [`RECORD_PADDING`] zero records.
+    records: Vec<Record>,
+    /// Triangles stored (the records without their padding).
+    count: usize,
     /// Per mesh: the point offsets are measured from.
     anchors: Vec<DVec3>,
     /// The anchor of every triangle when they all share one (the common
@@ -104,8 +109,7 @@ impl Triangles {
     pub fn new(triangles: &[(Triangle, u32)], order: &[u32], leaves: &[Leaf], anchors: Vec<DVec3>) -> Self {
         let count = order.len();
         let mut offsets = vec![0.0f32; 9 * count + OFFSET_PADDING];
-        let mut placement = vec![0u32; count + PLACEMENT_PADDING];
-        let mut cold = vec![ColdData { face: 0, material: 0 }; count];
+        let mut records = vec![Record::default(); count + RECORD_PADDING];
         let anchor_of = |mesh: u32| anchors.get(mesh as usize).copied().unwrap_or(DVec3::ZERO);
         for leaf in leaves {
             let n = leaf.count as usize;
@@ -125,23 +129,23 @@ impl Triangles {
                         offsets[9 * leaf.first as usize + (3 * vertex + axis) * n + lane] = offset[axis] as f32;
                     }
                 }
-                placement[slot] = mesh | ((lane as u32) << MESH_BITS) | ((n as u32 - 1) << (MESH_BITS + 2));
-                cold[slot] = ColdData {
+                records[slot] = Record {
+                    placement: mesh | ((lane as u32) << MESH_BITS) | ((n as u32 - 1) << (MESH_BITS + 2)),
                     face: triangle.face,
                     material: *material,
                 };
             }
         }
-        let first_anchor = placement.first().map(|&word| anchor_of(word & MESH_MASK));
+        let first_anchor = records[..count].first().map(|record| anchor_of(record.placement & MESH_MASK));
         let shared_anchor = first_anchor.filter(|&first| {
-            placement[..count]
-                .iter()
-                .all(|&word| anchor_of(word & MESH_MASK).to_array().map(f64::to_bits) == first.to_array().map(f64::to_bits))
+            records[..count].iter().all(|record| {
+                anchor_of(record.placement & MESH_MASK).to_array().map(f64::to_bits) == first.to_array().map(f64::to_bits)
+            })
         });
         Self {
             offsets,
-            placement,
-            cold,
+            records,
+            count,
             anchors,
             shared_anchor,
         }
@@ -149,17 +153,17 @@ impl Triangles {
 
     /// Number of triangles stored.
     pub fn len(&self) -> usize {
-        self.cold.len()
+        self.count
     }
 
     /// Whether no triangle is stored.
     pub fn is_empty(&self) -> bool {
-        self.cold.is_empty()
+        self.count == 0
     }
 
-    /// Bytes per triangle of leaf and hit data: nine offsets, the placement
-    /// word, face and material.
-    pub const BYTES_PER_TRIANGLE: usize = 9 * 4 + 4 + std::mem::size_of::<ColdData>();
+    /// Bytes per triangle of leaf and hit data: nine offsets and the
+    /// record (placement word, face and material).
+    pub const BYTES_PER_TRIANGLE: usize = 9 * 4 + std::mem::size_of::<Record>();
 
     fn anchor(&self, mesh: u32) -> DVec3 {
         self.anchors.get(mesh as usize).copied().unwrap_or(DVec3::ZERO)
@@ -167,7 +171,8 @@ impl Triangles {
 
     /// Triangle `index` (in leaf order) in double precision: the stored vertices.
     pub fn get(&self, index: u32) -> Triangle {
-        let word = self.placement[index as usize];
+        let record = self.records[index as usize];
+        let word = record.placement;
         let lane = (word >> MESH_BITS) & 3;
         let n = (word >> (MESH_BITS + 2)) as usize + 1;
         let base = 9 * (index - lane) as usize + lane as usize;
@@ -180,17 +185,17 @@ impl Triangles {
         Triangle {
             vertices: [vertex(0), vertex(1), vertex(2)],
             mesh: word & MESH_MASK,
-            face: self.cold[index as usize].face,
+            face: record.face,
         }
     }
 
     /// Which mesh, face and material triangle `index` (in leaf order) comes from.
     pub fn source(&self, index: u32) -> TriangleSource {
-        let cold = self.cold[index as usize];
+        let record = self.records[index as usize];
         TriangleSource {
-            mesh: self.placement[index as usize] & MESH_MASK,
-            face: cold.face,
-            material: cold.material,
+            mesh: record.placement & MESH_MASK,
+            face: record.face,
+            material: record.material,
         }
     }
 
@@ -206,7 +211,7 @@ impl Triangles {
         let anchor: [Lanes; 3] = match self.shared_anchor {
             Some(anchor) => ray.axes.map(|axis| Lanes::splat(anchor[axis])),
             None => {
-                let words: [u32; 4] = std::array::from_fn(|lane| self.placement[first + lane]);
+                let words: [u32; 4] = std::array::from_fn(|lane| self.records[first + lane].placement);
                 let anchors = words.map(|word| self.anchor(word & MESH_MASK));
                 ray.axes.map(|axis| Lanes::new(anchors.map(|a| a[axis])))
             }
