@@ -237,10 +237,12 @@ impl Triangles {
         let vertices = self.leaf_vertices(ray, first, count)?;
         let candidates = lanes::intersect(ray, &vertices, (1 << count) - 1, t_max)?;
         let (lane, hit) = candidates.nearest(t_max)?;
-        Some(LeafHit {
-            index: first + lane as u32,
-            hit,
-        })
+        let index = first + lane as u32;
+        // Read the record now, though only the final hit needs it: on a
+        // mesh larger than the caches its line then arrives while the
+        // traversal goes on, rather than after it.
+        std::hint::black_box(self.records.get(index as usize).map(|record| record.placement));
+        Some(LeafHit { index, hit })
     }
 
     /// Whether any of triangles `first .. first + count` (a leaf) is hit in `(0, t_max)`.
