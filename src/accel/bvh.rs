@@ -304,9 +304,9 @@ impl Bvh {
                             remaining &= remaining - 1;
                         }
                         if entered <= 4 {
-                            sort4(keys.first_chunk_mut().expect("eight keys"));
+                            sort_by_network::<4>(keys.first_chunk_mut().expect("eight keys"), &FOUR_KEY_NETWORK);
                         } else {
-                            sort8(&mut keys);
+                            sort_by_network(&mut keys, &EIGHT_KEY_NETWORK);
                         }
                         // Leave the farther ones for later, farthest deepest; go on with the nearest.
                         for &key in keys[1..entered as usize].iter().rev() {
@@ -347,53 +347,29 @@ impl Bvh {
     }
 }
 
-/// Sorts four keys ascending with five compare-exchanges (an optimal
-/// network), each a pair of conditional moves.
-#[inline(always)]
-fn sort4(keys: &mut [u64; 4]) {
-    let mut exchange = |a: usize, b: usize| {
-        let (low, high) = (keys[a].min(keys[b]), keys[a].max(keys[b]));
-        keys[a] = low;
-        keys[b] = high;
-    };
-    exchange(0, 1);
-    exchange(2, 3);
-    exchange(0, 2);
-    exchange(1, 3);
-    exchange(1, 2);
-}
+/// An optimal sorting network for four keys: five compare-exchanges.
+const FOUR_KEY_NETWORK: [(usize, usize); 5] = [(0, 1), (2, 3), (0, 2), (1, 3), (1, 2)];
 
-/// Sorts eight keys ascending with nineteen compare-exchanges (an optimal
-/// network, Knuth TAOCP vol. 3 §5.3.4).
+/// An optimal sorting network for eight keys: nineteen compare-exchanges
+/// (Knuth, TAOCP vol. 3 §5.3.4).
+#[rustfmt::skip]
+const EIGHT_KEY_NETWORK: [(usize, usize); 19] = [
+    (0, 2), (1, 3), (4, 6), (5, 7),
+    (0, 4), (1, 5), (2, 6), (3, 7),
+    (0, 1), (2, 3), (4, 5), (6, 7),
+    (2, 4), (3, 5),
+    (1, 4), (3, 6),
+    (1, 2), (3, 4), (5, 6),
+];
+
+/// Sorts `keys` ascending by `network`, each compare-exchange a pair of
+/// conditional moves (no data-dependent branches).
 #[inline(always)]
-fn sort8(keys: &mut [u64; 8]) {
-    let mut exchange = |a: usize, b: usize| {
+fn sort_by_network<const N: usize>(keys: &mut [u64; N], network: &[(usize, usize)]) {
+    for &(a, b) in network {
         let (low, high) = (keys[a].min(keys[b]), keys[a].max(keys[b]));
         keys[a] = low;
         keys[b] = high;
-    };
-    for (a, b) in [
-        (0, 2),
-        (1, 3),
-        (4, 6),
-        (5, 7),
-        (0, 4),
-        (1, 5),
-        (2, 6),
-        (3, 7),
-        (0, 1),
-        (2, 3),
-        (4, 5),
-        (6, 7),
-        (2, 4),
-        (3, 5),
-        (1, 4),
-        (3, 6),
-        (1, 2),
-        (3, 4),
-        (5, 6),
-    ] {
-        exchange(a, b);
     }
 }
 
@@ -669,14 +645,14 @@ mod tests {
         for bits in 0u32..256 {
             let mut eight: [u64; 8] = std::array::from_fn(|i| u64::from((bits >> i) & 1));
             let ones = bits.count_ones() as usize;
-            sort8(&mut eight);
+            sort_by_network(&mut eight, &EIGHT_KEY_NETWORK);
             assert!(
                 eight.iter().enumerate().all(|(i, &k)| k == u64::from(i >= 8 - ones)),
                 "{bits:08b}"
             );
             if bits < 16 {
                 let mut four: [u64; 4] = std::array::from_fn(|i| u64::from((bits >> i) & 1));
-                sort4(&mut four);
+                sort_by_network(&mut four, &FOUR_KEY_NETWORK);
                 assert!(
                     four.iter().enumerate().all(|(i, &k)| k == u64::from(i >= 4 - ones)),
                     "{bits:04b}"
