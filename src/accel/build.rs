@@ -189,7 +189,7 @@ impl BuildItem {
 pub const MAX_ITEMS: usize = 1 << 29;
 
 /// Added to the index and kind before they are stored as lane 3's bits:
-/// the lane then holds a normal float (2 to about 10¹⁹ for any index below
+/// the lane then holds a normal float (from 2 to 2⁶⁵ for any index below
 /// 2²⁹), never a subnormal, which some processors handle slowly in the
 /// arithmetic the other lanes need.
 const LANE3_OFFSET: u32 = 0x4000_0000;
