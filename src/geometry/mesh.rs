@@ -184,10 +184,11 @@ impl Mesh {
     /// Interpolated shading normal (if the mesh has normals) and uv (the
     /// barycentric coordinates when it has none) at a point of a face.
     pub fn shading(&self, face: usize, barycentric: [f64; 3]) -> (Option<DVec3>, DVec2) {
+        let barycentric_uv = DVec2::new(barycentric[1], barycentric[2]);
         if self.normals.is_empty() && self.uvs.is_empty() {
             // Neither needs the face's vertex indices, whose read costs
             // the hit a cache miss on a mesh larger than the caches.
-            return (None, DVec2::new(barycentric[1], barycentric[2]));
+            return (None, barycentric_uv);
         }
         let f = self.faces[face];
         let normal = (!self.normals.is_empty())
@@ -197,7 +198,7 @@ impl Mesh {
             })
             .flatten();
         let uv = if self.uvs.is_empty() {
-            DVec2::new(barycentric[1], barycentric[2])
+            barycentric_uv
         } else {
             (0..3).map(|k| barycentric[k] * self.uvs[f[k] as usize]).sum()
         };

@@ -81,8 +81,6 @@ pub struct Triangles {
     offsets: Vec<f32>,
     /// Per triangle, then [`RECORD_PADDING`] zero records.
     records: Vec<Record>,
-    /// Triangles stored (the records without their padding).
-    count: usize,
     /// Per mesh: the point offsets are measured from.
     anchors: Vec<DVec3>,
     /// The anchor of every triangle when they all share one (the common
@@ -145,7 +143,6 @@ impl Triangles {
         Self {
             offsets,
             records,
-            count,
             anchors,
             shared_anchor,
         }
@@ -153,12 +150,12 @@ impl Triangles {
 
     /// Number of triangles stored.
     pub fn len(&self) -> usize {
-        self.count
+        self.records.len().saturating_sub(RECORD_PADDING)
     }
 
     /// Whether no triangle is stored.
     pub fn is_empty(&self) -> bool {
-        self.count == 0
+        self.len() == 0
     }
 
     /// Bytes per triangle of leaf and hit data: nine offsets and the
