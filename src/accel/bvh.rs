@@ -303,6 +303,8 @@ impl Bvh {
                     // network orders them without data-dependent branches.
                     let mut keys = [u64::MAX; WIDTH];
                     let mut remaining = hit;
+                    // At most eight (one bit per lane), so the masks below
+                    // change nothing and spare bounds checks.
                     let mut entered = 0;
                     while remaining != 0 {
                         let lane = remaining.trailing_zeros() as usize;
