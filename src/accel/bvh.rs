@@ -27,6 +27,7 @@
 use super::bounds::{Bounds32, round_up, sign_mask32};
 use super::build::{self, BinaryContent, BinaryNode, Box4, BuildItem, LeafKind, MAX_LEAF_SIZE};
 use super::collapse::Collapse;
+use crate::math::lane_mask::set_lanes;
 use crate::math::{Aabb, Ray};
 use arrayvec::ArrayVec;
 use wide::{CmpLe, f32x8};
@@ -302,15 +303,12 @@ impl Bvh {
                     // the rest are all ones, which sort last. A sorting
                     // network orders them without data-dependent branches.
                     let mut keys = [u64::MAX; WIDTH];
-                    let mut remaining = hit;
                     // At most eight (one bit per lane), so the masks below
                     // change nothing and spare bounds checks.
                     let mut entered = 0;
-                    while remaining != 0 {
-                        let lane = remaining.trailing_zeros() as usize;
+                    for lane in set_lanes(hit) {
                         keys[entered & (WIDTH - 1)] = pack(node.children[lane], t_near[lane]);
                         entered += 1;
-                        remaining &= remaining - 1;
                     }
                     if entered <= 4 {
                         sort_by_network::<4>(keys.first_chunk_mut().expect("eight keys"), &FOUR_KEY_NETWORK);
@@ -325,13 +323,10 @@ impl Bvh {
                     continue;
                 } else {
                     // Any order will do: the first entered now, the others later.
-                    let mut remaining = hit;
-                    current = node.children[remaining.trailing_zeros() as usize];
-                    remaining &= remaining - 1;
-                    while remaining != 0 {
-                        let lane = remaining.trailing_zeros() as usize;
+                    let mut lanes = set_lanes(hit);
+                    current = node.children[lanes.next().unwrap_or_default()];
+                    for lane in lanes {
                         stack.push(pack(node.children[lane], t_near[lane]));
-                        remaining &= remaining - 1;
                     }
                     continue;
                 }

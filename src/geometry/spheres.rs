@@ -25,6 +25,7 @@
 
 use super::Sphere;
 use crate::math::Ray;
+use crate::math::lane_mask::set_lanes;
 use wide::{CmpGt, CmpLt, f64x4};
 
 /// Zeros after each array: a one-sphere leaf at the end reads three past it.
@@ -167,10 +168,7 @@ impl Spheres {
         let roots = self.roots(ray, first, count)?;
         let mut nearest = None;
         let mut bound = t_max;
-        let mut remaining = roots.mask;
-        while remaining != 0 {
-            let lane = remaining.trailing_zeros() as usize;
-            remaining &= remaining - 1;
+        for lane in set_lanes(roots.mask) {
             if let Some(t) = roots.within(lane, bound) {
                 bound = t;
                 nearest = Some(SphereHit {

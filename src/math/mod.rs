@@ -15,6 +15,7 @@ pub mod bernstein;
 pub mod chi_square;
 pub mod frame;
 pub mod gamma;
+pub mod lane_mask;
 pub mod quadrature;
 pub mod ray;
 pub mod roots;

@@ -16,6 +16,7 @@
 
 use super::super::triangle::{TriangleHit, TriangleRay};
 use crate::math::gamma;
+use crate::math::lane_mask::set_lanes;
 use wide::{CmpEq, CmpGe, CmpGt, CmpLe, CmpLt, f64x4};
 
 /// Four lanes of `f64`.
@@ -51,10 +52,7 @@ impl Candidates {
     pub fn nearest(&self, t_max: f64) -> Option<(usize, TriangleHit)> {
         let mut t_max = t_max;
         let mut nearest = None;
-        let mut remaining = self.mask;
-        while remaining != 0 {
-            let lane = remaining.trailing_zeros() as usize;
-            remaining &= remaining - 1;
+        for lane in set_lanes(self.mask) {
             let (t_scaled, det) = (self.t_scaled[lane], self.det[lane]);
             let beyond = if det < 0.0 {
                 t_scaled < t_max * det
