@@ -8,7 +8,7 @@
 //! prefixes of each pixel's sequence remain (0, m, 2)-nets, which is what
 //! lowers error at equal samples. `Random` draws independent uniforms.
 //!
-//! Only a path's first [`SOBOL_DIMENSIONS`] draws are Sobol' points; later
+//! Only a stream's first [`SOBOL_DIMENSIONS`] dimensions are Sobol' points; later
 //! ones are independent hashes, about a sixth of the cost. What
 //! stratification buys is concentrated in the integrand's low-dimensional
 //! projections (its "effective dimension", Caflisch, Morokoff & Owen 1997):
@@ -42,10 +42,17 @@ impl std::fmt::Display for SamplerKind {
     }
 }
 
-/// Draws of a path taken from the Sobol' sequence (the camera's two 2D
-/// draws and the first two bounces' four draws each, light selection, light
-/// point, BSDF direction and lobe); the rest are independent.
-pub const SOBOL_DIMENSIONS: u32 = 10;
+/// Dimensions of a stream taken from the Sobol' sequence; the rest are
+/// independent. For a camera path these are the camera's two 2D draws
+/// (film position, lens) and the first two bounces' light choice, light
+/// point, BSDF direction and lobe (each bounce takes five dimensions, the
+/// fifth its roulette's, which the first bounce never draws: see the path
+/// tracer's `BounceDraws`).
+pub const SOBOL_DIMENSIONS: u32 = 11;
+
+/// A 1D draw reserved by [`Sampler::defer_1d`], to be computed only if used.
+#[derive(Clone, Copy, Debug)]
+pub struct Deferred1d(u32);
 
 /// The sample stream of one pixel sample (one camera path).
 #[derive(Clone, Debug)]
@@ -72,9 +79,29 @@ impl Sampler {
 
     /// One uniform value in [0, 1).
     pub fn next_1d(&mut self) -> f64 {
-        let dimension_seed = self.next_dimension_seed();
+        self.dimension += 1;
+        self.draw_1d_at(self.dimension)
+    }
+
+    /// Reserves the next 1D draw without computing it: [`Sampler::draw_1d`]
+    /// computes it later, if needed, with the value [`Sampler::next_1d`]
+    /// would have given here.
+    #[inline]
+    pub fn defer_1d(&mut self) -> Deferred1d {
+        self.dimension += 1;
+        Deferred1d(self.dimension)
+    }
+
+    /// The value of a draw reserved by [`Sampler::defer_1d`].
+    #[inline]
+    pub fn draw_1d(&self, deferred: Deferred1d) -> f64 {
+        self.draw_1d_at(deferred.0)
+    }
+
+    fn draw_1d_at(&self, dimension: u32) -> f64 {
+        let dimension_seed = self.dimension_seed(dimension);
         match self.kind {
-            SamplerKind::Sobol if self.dimension <= SOBOL_DIMENSIONS => {
+            SamplerKind::Sobol if dimension <= SOBOL_DIMENSIONS => {
                 // The scrambled van der Corput point of the shuffled index:
                 // nested_uniform_scramble(reverse(index)), written so that
                 // reversals cancel (see `shuffled_index`).
@@ -155,7 +182,12 @@ impl Sampler {
 
     fn next_dimension_seed(&mut self) -> u64 {
         self.dimension += 1;
-        mix64(self.stream_seed ^ (self.dimension as u64).wrapping_mul(0xd1b5_4a32_d192_ed03))
+        self.dimension_seed(self.dimension)
+    }
+
+    #[inline]
+    fn dimension_seed(&self, dimension: u32) -> u64 {
+        mix64(self.stream_seed ^ (dimension as u64).wrapping_mul(0xd1b5_4a32_d192_ed03))
     }
 }
 
@@ -298,6 +330,26 @@ mod tests {
     /// Skipping a draw leaves every later draw as it was, for both kinds,
     /// whether the skipped draw was 1D or 2D and Sobol' or independent
     /// (the SPPM images stay bit for bit the same only if this holds).
+    /// A deferred draw, computed after later draws, is the value a plain
+    /// draw at its place gives, and the draws after it are unchanged.
+    #[test]
+    fn deferred_draws_equal_plain_draws_in_their_place() {
+        for kind in [SamplerKind::Sobol, SamplerKind::Random] {
+            for index in 0..64 {
+                let mut plain = Sampler::new(kind, 5, index, 2);
+                let mut deferring = plain.clone();
+                let expected: Vec<f64> = (0..14).map(|_| plain.next_1d()).collect();
+                let deferred: Vec<Deferred1d> = (0..7).map(|_| deferring.defer_1d()).collect();
+                for (dimension, &value) in expected.iter().enumerate().skip(7) {
+                    assert_eq!(deferring.next_1d(), value, "{kind}: sample {index}, dimension {dimension}");
+                }
+                for (dimension, draw) in deferred.into_iter().enumerate().rev() {
+                    assert_eq!(deferring.draw_1d(draw), expected[dimension], "{kind}: deferred {dimension}");
+                }
+            }
+        }
+    }
+
     #[test]
     fn skipped_draws_leave_later_draws_unchanged() {
         for kind in [SamplerKind::Sobol, SamplerKind::Random] {

@@ -20,7 +20,11 @@ use prism::spectrum::{EmissionSpectrum, LAMBDA_MAX, LAMBDA_MIN, SpectrumSource, 
 /// wall; wavelength noise at 24×24×32 moves the mean by about 10⁻⁴. The
 /// prediction lies well outside that from the white point (checked), so
 /// a light that ignored its spectrum would fail. Light sampling and BSDF
-/// sampling (emission reached by NEE or by a BSDF sample) both.
+/// sampling (emission reached by NEE or by a BSDF sample) both. BSDF
+/// sampling finds the small light on few paths, so its chromaticity is
+/// far noisier: over 8 seeds at 32 spp it scattered by 0.003–0.007 (rms,
+/// two sample layouts), at 512 spp by 0.0008. It renders 2048 spp
+/// (about 0.0004), well inside the tolerance.
 #[test]
 fn a_white_wall_under_d65_has_d65s_colour_on_this_film() {
     let loaded = wall("[0.8, 0.8, 0.8]", "spectrum = \"D65\"\nluminance = 5");
@@ -34,7 +38,10 @@ fn a_white_wall_under_d65_has_d65s_colour_on_this_film() {
             &Job {
                 width: 24,
                 height: 24,
-                spp: 32,
+                spp: match integrator {
+                    IntegratorKind::BsdfOnly => 2048,
+                    _ => 32,
+                },
                 integrator,
                 spectral: true,
                 ..Job::default()

@@ -11,7 +11,7 @@ use crate::color::Color;
 use crate::geometry::{Bounce, SurfaceHit};
 use crate::material::{ShadingPoint, Transport};
 use crate::math::{Frame as ShadingFrame, Ray, warp::power_heuristic};
-use crate::sampler::Sampler;
+use crate::sampler::{Deferred1d, Sampler};
 use crate::scene::{Leaving, Scene};
 use crate::settings::{IntegratorKind, RenderSettings};
 use crate::spectrum::{Radiance, SampledSpectrum, SampledWavelengths};
@@ -19,6 +19,49 @@ use glam::DVec2;
 
 /// Bounces before Russian roulette may end a path.
 const ROULETTE_START: u32 = 3;
+
+/// One bounce's draws from the sampler. Every bounce takes the same five
+/// dimensions in the same order (light choice, point on the light, BSDF
+/// direction, BSDF lobe, then the roulette's at the bounce's end), whatever
+/// surface it meets, so they can be drawn before the surface is known: at
+/// the top of the bounce, where their hash chains (tens of dependent
+/// multiplications) overlap the ray's traversal instead of following it.
+/// The two 2D draws, which nearly every surface reads, are computed then;
+/// the 1D draws only where read ([`Sampler::defer_1d`]).
+struct BounceDraws {
+    /// `None` with one light or none: nothing to choose.
+    light_choice: Option<Deferred1d>,
+    /// Zero without light sampling (never read).
+    light_point: DVec2,
+    direction: DVec2,
+    lobe: Deferred1d,
+}
+
+impl BounceDraws {
+    #[inline]
+    fn new(sampler: &mut Sampler, light_sampling: bool, several_lights: bool) -> Self {
+        let light_choice = match several_lights {
+            true => Some(sampler.defer_1d()),
+            false => {
+                sampler.skip();
+                None
+            }
+        };
+        let light_point = match light_sampling {
+            true => sampler.next_2d(),
+            false => {
+                sampler.skip();
+                DVec2::ZERO
+            }
+        };
+        Self {
+            light_choice,
+            light_point,
+            direction: sampler.next_2d(),
+            lobe: sampler.defer_1d(),
+        }
+    }
+}
 
 /// Options of the per-sample tracer.
 #[derive(Clone, Copy, Debug)]
@@ -117,6 +160,7 @@ impl PathTracer {
         let mut off_ball_from_lens: Option<(usize, Ray)> = None;
 
         for bounce in 0.. {
+            let draws = BounceDraws::new(sampler, light_sampling, scene.lights.len() > 1);
             let Some(intersection) = scene.intersect_leaving(&ray, f64::INFINITY, leaving) else {
                 radiance += throughput * C::from_rgb(scene.background, wavelengths);
                 break;
@@ -163,12 +207,20 @@ impl PathTracer {
                 point: hit.point,
             };
 
+            // The BSDF sample that continues the path, made before the light
+            // sample: it does not depend on it, so its arithmetic overlaps
+            // the shadow ray's traversal instead of following it.
+            let (uses_direction, uses_lobe) = material.sample_inputs();
+            let u = if uses_direction { draws.direction } else { DVec2::ZERO };
+            let u_lobe = if uses_lobe { sampler.draw_1d(draws.lobe) } else { 0.5 };
+            let bsdf_sample = C::sample_bsdf(material, wo, &at, u, u_lobe, Transport::Radiance, wavelengths);
+
             // Next-event estimation: one light sample, MIS-weighted.
             let mut connected_by_balls = false;
             if light_sampling && !material.is_specular() {
                 // With one light there is nothing to select: no draw.
-                let u_select = if scene.lights.len() > 1 { sampler.next_1d() } else { 0.5 };
-                let u_light = sampler.next_2d();
+                let u_select = draws.light_choice.map_or(0.5, |draw| sampler.draw_1d(draw));
+                let u_light = draws.light_point;
                 // And through glass balls and off mirror balls, with the
                 // same numbers, at the first surface that is not specular
                 // (where the rest of the path is most often light focused
@@ -201,11 +253,8 @@ impl PathTracer {
 
             specular_chain &= material.is_specular();
 
-            // Continue the path by sampling the BSDF.
-            let (uses_direction, uses_lobe) = material.sample_inputs();
-            let u = if uses_direction { sampler.next_2d() } else { DVec2::ZERO };
-            let u_lobe = if uses_lobe { sampler.next_1d() } else { 0.5 };
-            let Some(sample) = C::sample_bsdf(material, wo, &at, u, u_lobe, Transport::Radiance, wavelengths) else {
+            // Continue the path by the BSDF sample.
+            let Some(sample) = bsdf_sample else {
                 break;
             };
             throughput *= C::from_rgb(sample.weight, wavelengths);
@@ -238,7 +287,9 @@ impl PathTracer {
             // counting glass's 1/η² (Veach 1997 §5.2): inside a ball two
             // thirds of the paths would die for the rest to come out with
             // 2.25 times the weight.
-            if bounce + 1 >= ROULETTE_START {
+            if bounce + 1 < ROULETTE_START {
+                sampler.skip(); // the roulette's dimension, unused
+            } else {
                 let survival = (throughput.max_component() * eta_scale).min(0.95);
                 if sampler.next_1d_independent() >= survival {
                     break;
