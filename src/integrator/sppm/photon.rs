@@ -20,7 +20,6 @@
 //! other draws are those of an RGB photon); a dispersive interface sends it
 //! on at its hero wavelength only, as for camera paths.
 
-use super::visible_point::bsdf_inputs;
 use crate::color::{Color, luminance};
 use crate::geometry::SurfaceHit;
 use crate::light::EmitterSource;
@@ -29,6 +28,7 @@ use crate::math::{DVec3, Frame as ShadingFrame, Ray, warp};
 use crate::sampler::Sampler;
 use crate::scene::Scene;
 use crate::spectrum::Radiance;
+use glam::DVec2;
 use std::f64::consts::PI;
 
 /// A photon leaving a light, carrying RGB or spectral flux `C`.
@@ -197,6 +197,13 @@ pub fn trace<C: Radiance>(
         mut wavelengths,
     } = photon;
     for depth in 1..=max_depth {
+        // This bounce's draws (direction, lobe, roulette: the dimensions
+        // `bsdf_inputs` and the roulette take), made before the traversal,
+        // which they do not depend on, so their hash chains overlap it. The
+        // direction, which most surfaces read, is computed now; the rest
+        // only where read.
+        let u_direction = sampler.next_2d();
+        let (u_lobe, u_roulette) = (sampler.defer_1d(), sampler.defer_1d());
         let Some(intersection) = scene.intersect(&ray, f64::INFINITY) else {
             return;
         };
@@ -219,7 +226,9 @@ pub fn trace<C: Radiance>(
             uv: hit.uv,
             point: hit.point,
         };
-        let (u, u_lobe) = bsdf_inputs(material, sampler);
+        let (uses_direction, uses_lobe) = material.sample_inputs();
+        let u = if uses_direction { u_direction } else { DVec2::ZERO };
+        let u_lobe = if uses_lobe { sampler.draw_1d(u_lobe) } else { 0.5 };
         let wo = frame.to_local(towards_light);
         let Some(sample) = C::sample_bsdf(material, wo, &at, u, u_lobe, Transport::Importance, &mut wavelengths) else {
             return;
@@ -231,7 +240,7 @@ pub fn trace<C: Radiance>(
         // Russian roulette: continue with probability of the luminance ratio,
         // so surviving photons keep about the flux they had.
         let continue_probability = (scattered.brightness() / flux.brightness()).min(1.0);
-        if continue_probability.is_nan() || continue_probability <= 0.0 || sampler.next_1d() >= continue_probability {
+        if continue_probability.is_nan() || continue_probability <= 0.0 || sampler.draw_1d(u_roulette) >= continue_probability {
             return;
         }
         flux = scattered / continue_probability;
