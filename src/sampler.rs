@@ -327,9 +327,6 @@ mod tests {
         }
     }
 
-    /// Skipping a draw leaves every later draw as it was, for both kinds,
-    /// whether the skipped draw was 1D or 2D and Sobol' or independent
-    /// (the SPPM images stay bit for bit the same only if this holds).
     /// A deferred draw, computed after later draws, is the value a plain
     /// draw at its place gives, and the draws after it are unchanged.
     #[test]
@@ -350,6 +347,9 @@ mod tests {
         }
     }
 
+    /// Skipping a draw leaves every later draw as it was, for both kinds,
+    /// whether the skipped draw was 1D or 2D and Sobol' or independent
+    /// (the SPPM images stay bit for bit the same only if this holds).
     #[test]
     fn skipped_draws_leave_later_draws_unchanged() {
         for kind in [SamplerKind::Sobol, SamplerKind::Random] {

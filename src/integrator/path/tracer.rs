@@ -9,6 +9,7 @@ use super::ball_connection::{Departure, Passage, radiance_by_balls};
 use super::lens_connection::LensView;
 use crate::color::Color;
 use crate::geometry::{Bounce, SurfaceHit};
+use crate::integrator::sppm::visible_point::bsdf_inputs_drawn;
 use crate::material::{ShadingPoint, Transport};
 use crate::math::{Frame as ShadingFrame, Ray, warp::power_heuristic};
 use crate::sampler::{Deferred1d, Sampler};
@@ -210,9 +211,7 @@ impl PathTracer {
             // The BSDF sample that continues the path, made before the light
             // sample: it does not depend on it, so its arithmetic overlaps
             // the shadow ray's traversal instead of following it.
-            let (uses_direction, uses_lobe) = material.sample_inputs();
-            let u = if uses_direction { draws.direction } else { DVec2::ZERO };
-            let u_lobe = if uses_lobe { sampler.draw_1d(draws.lobe) } else { 0.5 };
+            let (u, u_lobe) = bsdf_inputs_drawn(material, draws.direction, draws.lobe, sampler);
             let bsdf_sample = C::sample_bsdf(material, wo, &at, u, u_lobe, Transport::Radiance, wavelengths);
 
             // Next-event estimation: one light sample, MIS-weighted.

@@ -20,6 +20,7 @@
 //! other draws are those of an RGB photon); a dispersive interface sends it
 //! on at its hero wavelength only, as for camera paths.
 
+use super::visible_point::bsdf_inputs_drawn;
 use crate::color::{Color, luminance};
 use crate::geometry::SurfaceHit;
 use crate::light::EmitterSource;
@@ -28,7 +29,6 @@ use crate::math::{DVec3, Frame as ShadingFrame, Ray, warp};
 use crate::sampler::Sampler;
 use crate::scene::Scene;
 use crate::spectrum::Radiance;
-use glam::DVec2;
 use std::f64::consts::PI;
 
 /// A photon leaving a light, carrying RGB or spectral flux `C`.
@@ -226,9 +226,7 @@ pub fn trace<C: Radiance>(
             uv: hit.uv,
             point: hit.point,
         };
-        let (uses_direction, uses_lobe) = material.sample_inputs();
-        let u = if uses_direction { u_direction } else { DVec2::ZERO };
-        let u_lobe = if uses_lobe { sampler.draw_1d(u_lobe) } else { 0.5 };
+        let (u, u_lobe) = bsdf_inputs_drawn(material, u_direction, u_lobe, sampler);
         let wo = frame.to_local(towards_light);
         let Some(sample) = C::sample_bsdf(material, wo, &at, u, u_lobe, Transport::Importance, &mut wavelengths) else {
             return;
