@@ -2,9 +2,11 @@
 """Mitsuba 3 against Prism on the same scenes: paths per second and
 equal-time error.
 
-The Prism scene files (default scenes/cornell.toml and scenes/bunny.toml) are
-translated into Mitsuba scene dictionaries here (`translate`), so both
-renderers see the same geometry, camera, materials and lights:
+The Prism scene files (default scenes/cornell.toml, scenes/bunny.toml and
+benches/peers/cornell_box_mitsuba.toml, Mitsuba's own `mitsuba.cornell_box()`
+written as a Prism scene) are translated into Mitsuba scene dictionaries here
+(`translate`), so both renderers see the same geometry, camera, materials and
+lights:
 
 - camera: `perspective`, vertical field of view (`fov_axis = "y"`), look-at
   frame from position, look_at and up; a box pixel filter one pixel wide, as
@@ -509,7 +511,12 @@ def machine_note():
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("scenes", nargs="*", default=["scenes/cornell.toml", "scenes/bunny.toml"], help="Prism scene files")
+    parser.add_argument(
+        "scenes",
+        nargs="*",
+        default=["scenes/cornell.toml", "scenes/bunny.toml", "benches/peers/cornell_box_mitsuba.toml"],
+        help="Prism scene files",
+    )
     parser.add_argument("--prism", default="target/release/prism", help="the prism binary")
     parser.add_argument("--variant", default="llvm_ad_rgb", help="Mitsuba variant (falls back to scalar_rgb if unusable)")
     parser.add_argument("--output-dir", default="benches/peers/results")
