@@ -53,6 +53,7 @@ render scenes/cornell.toml --spectral --width 96 --height 96 --spp 8
 
 echo "== 3/3 optimised build (target/pgo)"
 "$profdata" merge -o "$profiles/merged.profdata" "$profiles/raw"
-RUSTFLAGS="$base_flags -Cprofile-use=$profiles/merged.profdata" \
+# PRISM_PGO marks the binary as profile-guided in its benchmarks' CSV headers.
+PRISM_PGO=1 RUSTFLAGS="$base_flags -Cprofile-use=$profiles/merged.profdata" \
     cargo build --release --locked --target-dir target/pgo
 echo "built target/pgo/release/prism"

@@ -66,15 +66,39 @@ impl From<crate::metrics::SizeMismatch> for BenchError {
     }
 }
 
-/// One line describing the machine and its load, for CSV headers: the
-/// benchmarks share a machine, and a time means little without its load.
+/// One line describing the machine, its load and this binary's build, for
+/// CSV headers: the benchmarks share a machine, and a time means little
+/// without its load, nor without the build that made it.
 pub fn machine_note() -> String {
     let load = std::fs::read_to_string("/proc/loadavg").map_or_else(
         |_| "unknown".to_string(),
         |s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "),
     );
     let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
-    format!("{cores} logical cores, load average (1/5/15 min) {load}")
+    format!("{cores} logical cores, load average (1/5/15 min) {load}; {}", build_note())
+}
+
+/// How this binary was compiled: the same code runs faster when built for
+/// a newer instruction set or with a profile (docs/performance.md,
+/// "Profile-guided and host-tuned builds"). `benches/pgo/build.sh` sets
+/// `PRISM_PGO` while it compiles the profile-guided binary.
+pub fn build_note() -> String {
+    let kind = if cfg!(debug_assertions) { "debug" } else { "release" };
+    let instruction_set = if cfg!(target_feature = "avx512f") {
+        "AVX-512"
+    } else if cfg!(target_feature = "avx2") {
+        "AVX2"
+    } else if cfg!(target_arch = "x86_64") {
+        "baseline x86-64"
+    } else {
+        std::env::consts::ARCH
+    };
+    let profile = if option_env!("PRISM_PGO").is_some() {
+        ", profile-guided"
+    } else {
+        ""
+    };
+    format!("{kind} build for {instruction_set}{profile}")
 }
 
 /// A CSV table: `#` comment lines, a header, rows; written atomically.
