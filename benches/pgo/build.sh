@@ -17,7 +17,7 @@
 # The optimised binary computes exactly what the plain release build does
 # (profiles change code layout and inlining, never floating-point semantics):
 # the same pixels, bit for bit. Measured gains: docs/performance.md,
-# "Profile-guided builds".
+# "Profile-guided and host-tuned builds".
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/../.." && pwd)
