@@ -5,7 +5,7 @@ mod interrupt;
 mod merge_command;
 
 use anyhow::{Context, Result, bail};
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use prism::farm::file::PendingFilm;
 use prism::farm::{FilmHeader, PartRequest, content_hash, is_film_path, plan_share};
@@ -20,6 +20,7 @@ use prism::settings::{RadiusSchedule, Setting, SettingsPatch};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::LazyLock;
 use std::sync::atomic::AtomicBool;
 
 #[derive(Parser)]
@@ -163,8 +164,14 @@ fn parse_tone_map(s: &str) -> Result<ToneMap, String> {
     }
 }
 
+/// `prism --version`: the package version and how this binary was built
+/// (instruction set, profile-guided or not), which decides its speed and
+/// which machines of a farm it runs on.
+static VERSION: LazyLock<String> = LazyLock::new(|| format!("{} ({})", env!("CARGO_PKG_VERSION"), prism::bench::build_note()));
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let matches = Cli::command().version(VERSION.as_str()).get_matches();
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|error| error.exit());
     let result = match cli.command {
         Some(Command::Render(args)) => render_command(args),
         Some(Command::Merge(args)) => merge_command::merge_command(args).map(|()| RenderEnd::Completed),

@@ -120,3 +120,21 @@ fn the_output_is_checked_before_rendering() {
     );
     assert!(started.elapsed() < Duration::from_secs(4), "rendered before failing");
 }
+
+/// `--version` names the build as well as the version: a farm's operator
+/// checks it to know which machines a binary runs on and how fast.
+#[test]
+fn the_version_names_the_build() {
+    let output = Command::new(env!("CARGO_BIN_EXE_prism"))
+        .arg("--version")
+        .output()
+        .expect("run prism");
+    assert!(output.status.success());
+    let text = String::from_utf8_lossy(&output.stdout);
+    let expected = format!(
+        "prism {} ({} build for ",
+        env!("CARGO_PKG_VERSION"),
+        if cfg!(debug_assertions) { "debug" } else { "release" }
+    );
+    assert!(text.starts_with(&expected), "{text:?} should start with {expected:?}");
+}
