@@ -4,6 +4,8 @@
 //! view needs from a particular integrator (SPPM's gather radii, a cheaper
 //! preview) comes through the [`Integrator`] trait.
 //!
+//! - [`bsdf_inputs`]: a BSDF's sample inputs drawn from a sample stream
+//!   (shared by path tracing and SPPM);
 //! - [`pass`]: the parallel pixel loop that per-pixel integrators share,
 //!   with adaptive sampling;
 //! - [`path`]: path tracing with light sampling and MIS, or BSDF sampling only;
@@ -11,6 +13,7 @@
 //! - [`share`]: which samples and rows a render computes (a whole image, or
 //!   one machine's part of a farm render).
 
+pub mod bsdf_inputs;
 pub mod pass;
 pub mod path;
 pub mod share;

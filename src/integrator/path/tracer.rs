@@ -9,7 +9,7 @@ use super::ball_connection::{Departure, Passage, radiance_by_balls};
 use super::lens_connection::LensView;
 use crate::color::Color;
 use crate::geometry::{Bounce, SurfaceHit};
-use crate::integrator::sppm::visible_point::bsdf_inputs_drawn;
+use crate::integrator::bsdf_inputs::bsdf_inputs_drawn;
 use crate::material::{ShadingPoint, Transport};
 use crate::math::{Frame as ShadingFrame, Ray, warp::power_heuristic};
 use crate::sampler::{Deferred1d, Sampler};

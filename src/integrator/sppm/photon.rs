@@ -20,9 +20,9 @@
 //! other draws are those of an RGB photon); a dispersive interface sends it
 //! on at its hero wavelength only, as for camera paths.
 
-use super::visible_point::bsdf_inputs_drawn;
 use crate::color::{Color, luminance};
 use crate::geometry::SurfaceHit;
+use crate::integrator::bsdf_inputs::bsdf_inputs_drawn;
 use crate::light::EmitterSource;
 use crate::material::{ShadingPoint, Transport};
 use crate::math::{DVec3, Frame as ShadingFrame, Ray, warp};

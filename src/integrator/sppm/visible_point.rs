@@ -16,9 +16,10 @@
 //! the two sides in sensor RGB).
 
 use crate::color::Color;
-use crate::material::{Material, ShadingPoint, Transport};
-use crate::math::{DVec2, DVec3, Frame as ShadingFrame, Ray};
-use crate::sampler::{Deferred1d, Sampler};
+use crate::integrator::bsdf_inputs::bsdf_inputs;
+use crate::material::{ShadingPoint, Transport};
+use crate::math::{DVec3, Frame as ShadingFrame, Ray};
+use crate::sampler::Sampler;
 use crate::scene::Scene;
 use crate::spectrum::{Emission, Radiance};
 
@@ -149,38 +150,4 @@ fn trace<C: Radiance, const VISIBLE_POINT: bool>(
         emitted: emitted.to_rgb(&wavelengths),
         visible_point,
     }
-}
-
-/// [`bsdf_inputs`] for draws made ahead, before the surface was known: the
-/// direction drawn, and the lobe reserved and computed here only if the
-/// BSDF reads it.
-#[inline]
-pub fn bsdf_inputs_drawn(material: &Material, direction: DVec2, lobe: Deferred1d, sampler: &Sampler) -> (DVec2, f64) {
-    let (uses_direction, uses_lobe) = material.sample_inputs();
-    let u = if uses_direction { direction } else { DVec2::ZERO };
-    let u_lobe = if uses_lobe { sampler.draw_1d(lobe) } else { 0.5 };
-    (u, u_lobe)
-}
-
-/// The direction and lobe samples for scattering off `material`, drawn as
-/// two dimensions of `sampler` always (a 2D and a 1D draw, so the stream's
-/// later draws do not depend on the material), but computed only where
-/// [`Material::sample_inputs`] says the BSDF reads them; the rest are
-/// placeholders it ignores. The values it reads are those plain draws give.
-#[inline]
-pub fn bsdf_inputs(material: &Material, sampler: &mut Sampler) -> (DVec2, f64) {
-    let (uses_direction, uses_lobe) = material.sample_inputs();
-    let u = if uses_direction {
-        sampler.next_2d()
-    } else {
-        sampler.skip();
-        DVec2::ZERO
-    };
-    let u_lobe = if uses_lobe {
-        sampler.next_1d()
-    } else {
-        sampler.skip();
-        0.5
-    };
-    (u, u_lobe)
 }
