@@ -105,7 +105,7 @@ impl Sampler {
                 // The scrambled van der Corput point of the shuffled index:
                 // nested_uniform_scramble(reverse(index)), written so that
                 // reversals cancel (see `shuffled_index`).
-                let index = self.shuffled_index(dimension_seed as u32);
+                let (index, _) = self.shuffled_index(dimension_seed as u32);
                 to_unit(laine_karras_permutation(index, (dimension_seed >> 32) as u32).reverse_bits())
             }
             _ => to_unit(self.independent_bits(dimension_seed) as u32),
@@ -130,13 +130,13 @@ impl Sampler {
         let dimension_seed = self.next_dimension_seed();
         match self.kind {
             SamplerKind::Sobol if self.dimension <= SOBOL_DIMENSIONS => {
-                let index = self.shuffled_index(dimension_seed as u32);
+                let (index, second_dimension_reversed) = self.shuffled_index(dimension_seed as u32);
                 let scramble = mix64(dimension_seed);
                 // Sobol' dimensions 0 (reverse(index)) and 1, each Owen-scrambled:
                 // nested_uniform_scramble(v) = reverse(LK(reverse(v))), and
                 // reverse(v) is `index` itself or the bit-reversed dimension 1.
                 let x = laine_karras_permutation(index, scramble as u32);
-                let y = laine_karras_permutation(sobol_second_dimension_reversed(index), (scramble >> 32) as u32);
+                let y = laine_karras_permutation(second_dimension_reversed, (scramble >> 32) as u32);
                 // Both reversed at once: reversing the 64 bits (y, x) gives
                 // (reverse(x), reverse(y)), one bit reversal instead of two
                 // (x86-64 has no instruction for it: a byte swap and three
@@ -161,10 +161,12 @@ impl Sampler {
         self.dimension += 1;
     }
 
-    /// The per-dimension shuffle of the sample index, nested_uniform_scramble(index, seed).
+    /// The per-dimension shuffle of the sample index,
+    /// nested_uniform_scramble(index, seed) = reverse(LK(reverse(index))),
+    /// with the bit-reversed second Sobol' dimension of the shuffled index.
     #[inline]
-    fn shuffled_index(&self, seed: u32) -> u32 {
-        laine_karras_permutation(self.reversed_index, seed).reverse_bits()
+    fn shuffled_index(&self, seed: u32) -> (u32, u32) {
+        index_and_second_dimension(laine_karras_permutation(self.reversed_index, seed))
     }
 
     /// A second stream of the same pixel sample, scrambled independently
@@ -196,40 +198,47 @@ fn to_unit(bits: u32) -> f64 {
     bits as f64 * (1.0 / 4_294_967_296.0)
 }
 
-/// The second Sobol' dimension (primitive polynomial x + 1), bit-reversed:
-/// direction numbers v₁ = 2³¹, vⱼ₊₁ = vⱼ ⊕ (vⱼ >> 1) are XORed for each set
-/// bit of `index`. The map is linear over XOR, so it is tabulated per byte.
-fn sobol_second_dimension_reversed(index: u32) -> u32 {
-    let t = &SOBOL_SECOND_DIMENSION_REVERSED;
-    t[0][(index & 0xff) as usize]
-        ^ t[1][((index >> 8) & 0xff) as usize]
-        ^ t[2][((index >> 16) & 0xff) as usize]
-        ^ t[3][(index >> 24) as usize]
+/// From an index's reversed bits, the index (its bits put back in order)
+/// and its second Sobol' dimension (primitive polynomial x + 1),
+/// bit-reversed: direction numbers v₁ = 2³¹, vⱼ₊₁ = vⱼ ⊕ (vⱼ >> 1), XORed
+/// for each set bit of the index. Both maps are linear over XOR, so one table
+/// per byte gives both, the index in the low half of each entry: four loads
+/// instead of four loads and a bit reversal (x86-64 has no instruction for
+/// it: a byte swap and three rounds of masks and shifts).
+#[inline]
+fn index_and_second_dimension(reversed: u32) -> (u32, u32) {
+    let t = &INDEX_AND_SECOND_DIMENSION;
+    let both = t[0][(reversed & 0xff) as usize]
+        ^ t[1][((reversed >> 8) & 0xff) as usize]
+        ^ t[2][((reversed >> 16) & 0xff) as usize]
+        ^ t[3][(reversed >> 24) as usize];
+    (both as u32, (both >> 32) as u32)
 }
 
-const SOBOL_SECOND_DIMENSION_REVERSED: [[u32; 256]; 4] = {
-    let mut directions = [0u32; 32];
+const INDEX_AND_SECOND_DIMENSION: [[u64; 256]; 4] = {
+    let mut directions_reversed = [0u32; 32];
     let mut v = 1u32 << 31;
     let mut j = 0;
     while j < 32 {
-        directions[j] = v.reverse_bits();
+        directions_reversed[j] = v.reverse_bits();
         v ^= v >> 1;
         j += 1;
     }
-    let mut tables = [[0u32; 256]; 4];
+    let mut tables = [[0u64; 256]; 4];
     let mut byte = 0;
     while byte < 4 {
         let mut value = 0;
         while value < 256 {
-            let mut acc = 0;
+            let index = ((value as u32) << (8 * byte)).reverse_bits();
+            let mut second = 0;
             let mut bit = 0;
-            while bit < 8 {
-                if value & (1 << bit) != 0 {
-                    acc ^= directions[byte * 8 + bit];
+            while bit < 32 {
+                if index & (1 << bit) != 0 {
+                    second ^= directions_reversed[bit];
                 }
                 bit += 1;
             }
-            tables[byte][value] = acc;
+            tables[byte][value] = index as u64 | (second as u64) << 32;
             value += 1;
         }
         byte += 1;
@@ -308,10 +317,13 @@ mod tests {
     /// The fast paths compute exactly Burley's formulation.
     #[test]
     fn fast_sobol_equals_the_definition() {
-        for index in [0u32, 1, 2, 3, 77, 1 << 20, u32::MAX, 0x1234_5678] {
+        for index in [0u32, 1, 2, 3, 77, 1 << 20, u32::MAX, 0x1234_5678]
+            .into_iter()
+            .chain((0..10_000u64).map(|i| mix64(i) as u32))
+        {
             assert_eq!(
-                sobol_second_dimension_reversed(index),
-                sobol_second_dimension(index).reverse_bits()
+                index_and_second_dimension(index.reverse_bits()),
+                (index, sobol_second_dimension(index).reverse_bits())
             );
         }
         let (pixel, sample, seed) = (12u64, 37u32, 5u64);
