@@ -15,20 +15,23 @@
 # CHANGES (default 6). Needs xvfb, openbox, xdotool and libgl1-mesa-dri;
 # not run by CI (about 15 s per run).
 set -euo pipefail
-cd "$(dirname "$0")/.."
 
+# Paths as given, made absolute before the script moves to the repository.
 binaries=()
 scene=()
 while (($#)); do
     if [[ $1 == -- ]]; then
-        shift
-        scene=(view "$@")
+        (($# == 2)) || { echo "usage: $0 BINARY... [-- SCENE]" >&2; exit 2; }
+        [[ -f $2 ]] || { echo "viewer_latency: no scene file $2" >&2; exit 2; }
+        scene=(view "$(realpath "$2")")
         break
     fi
-    binaries+=("$1")
+    [[ -x $1 ]] || { echo "viewer_latency: $1 is not an executable" >&2; exit 2; }
+    binaries+=("$(realpath "$1")")
     shift
 done
 ((${#binaries[@]})) || { echo "usage: $0 BINARY... [-- SCENE]" >&2; exit 2; }
+cd "$(dirname "$0")/.."
 for tool in xvfb-run openbox xdotool; do
     command -v "$tool" >/dev/null || { echo "viewer_latency: $tool is not installed" >&2; exit 2; }
 done
