@@ -54,6 +54,11 @@ def main():
             total = cost
             continue
         file, _, function = name.partition(":")
+        # callgrind_annotate prints files under the current folder relatively
+        # ("src/…" when run from the repository root): anchor them so the
+        # "/src/…" tests match either way.
+        if not file.startswith("/"):
+            file = "/" + file
         function = re.sub(r"\s*\[.*\]$", "", function)
         stage = next((s for s, by_file, _ in STAGES if by_file(file)), None)
         if stage is None:
