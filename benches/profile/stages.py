@@ -26,11 +26,13 @@ STAGES = [
      lambda n: "Lights::" in n or "sample_from" in n or "sample_area" in n or "Shape::area" in n),
     ("shadow rays", lambda f: False, lambda n: "occluded" in n),
     ("intersection", lambda f: "/src/accel/" in f or "/src/geometry/" in f or "/src/scene/" in f or "/math/ray" in f,
-     lambda n: "Scene::intersect" in n or "hit_distance" in n or "::intersect" in n),
+     lambda n: "Scene::intersect" in n or "hit_distance" in n or "::intersect" in n or "surface_hit" in n
+     or "offset_ray_origin" in n or "BallOptics" in n),
     ("BSDF", lambda f: "/src/material/" in f, lambda n: "Material::" in n or "Texture::" in n),
     ("shading frame", lambda f: "/math/frame" in f, lambda n: "Frame::" in n),
     ("film", lambda f: "/src/film" in f, lambda n: "PixelAccumulator" in n or "Film::" in n),
-    ("integrator", lambda f: "/src/integrator/" in f, lambda n: "PathTracer" in n or "Sppm" in n or "photon" in n),
+    ("integrator", lambda f: "/src/integrator/" in f,
+     lambda n: "PathIntegrator" in n or "PathTracer" in n or "Sppm" in n or "photon" in n),
 ]
 
 
