@@ -18,12 +18,12 @@ set -euo pipefail
 
 # Paths as given, made absolute before the script moves to the repository.
 binaries=()
-scene=()
+scene=""
 while (($#)); do
     if [[ $1 == -- ]]; then
         (($# == 2)) || { echo "usage: $0 BINARY... [-- SCENE]" >&2; exit 2; }
         [[ -f $2 ]] || { echo "viewer_latency: no scene file $2" >&2; exit 2; }
-        scene=(view "$(realpath "$2")")
+        scene=$(realpath "$2")
         break
     fi
     [[ -x $1 ]] || { echo "viewer_latency: $1 is not an executable" >&2; exit 2; }
@@ -43,14 +43,15 @@ trap 'rm -f "$rows"' EXIT
 # One run: prints the viewer's log on stdout.
 run_once() {
     local bin=$1
-    export bin changes scene_args="${scene[*]:-}"
+    export bin changes scene
     LIBGL_ALWAYS_SOFTWARE=1 LP_NUM_THREADS=1 xvfb-run -a -s "-screen 0 1280x800x24" bash -c '
         set -euo pipefail
         openbox >/dev/null 2>&1 &
         openbox_pid=$!
         sleep 1
         log=$(mktemp)
-        PRISM_VIEWER_LOG=1 "$bin" $scene_args 2>"$log" &
+        # `prism view SCENE`, or the embedded default scene without one.
+        PRISM_VIEWER_LOG=1 "$bin" ${scene:+view "$scene"} 2>"$log" &
         viewer=$!
         trap "kill $viewer $openbox_pid 2>/dev/null || true; rm -f $log" EXIT
         for _ in $(seq 1 600); do
