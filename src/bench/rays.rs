@@ -158,7 +158,10 @@ fn time_rays(pool: &rayon::ThreadPool, rays: &[Ray], repetitions: usize, query: 
     for _ in 0..repetitions {
         let start = Instant::now();
         hits = pool.install(|| {
+            // One chunk per job, as benches/peers/embree_rays.py deals them
+            // to its threads (see `integrator::pass` for rayon's default).
             rays.par_chunks(4096)
+                .with_max_len(1)
                 .map(|chunk| chunk.iter().filter(|r| query(r)).count())
                 .sum::<usize>()
         });

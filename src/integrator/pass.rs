@@ -1,6 +1,6 @@
 //! The one parallel pixel loop every per-pixel integrator shares: rows are
-//! handed to rayon's workers, each owns its pixels (no locks), and the
-//! cancel flag is checked once per row.
+//! handed to rayon's workers one at a time, each owns its pixels (no locks),
+//! and the cancel flag is checked once per row.
 //!
 //! Adaptive sampling skips pixels whose estimate is already good enough. A
 //! pixel's activity is decided only from its own accumulated state at the
@@ -81,7 +81,14 @@ pub fn add_samples_where(
     let width = film.width as usize;
     let (columns, lines) = (pixels.x0 as usize..pixels.x1 as usize, pixels.y0 as usize..pixels.y1 as usize);
     let rejected = AtomicU64::new(0);
-    let film_rows = film.pixels.par_chunks_mut(width).enumerate();
+    // One row per job. Rayon would otherwise cut the rows into as many
+    // pieces as threads, halved once more, and split a piece again only
+    // when another thread steals it; the last piece a thread starts (an
+    // eighth to a quarter of the image on two threads) then runs alone to
+    // its end while the others wait. Rows through glass or a bunny cost
+    // several times rows of sky, so that tail was a tenth of a glass
+    // scene's two-thread render (docs/performance.md, "Parallel jobs").
+    let film_rows = film.pixels.par_chunks_mut(width).with_max_len(1).enumerate();
     film_rows.skip(lines.start).take(lines.len()).for_each(|(y, row)| {
         if cancel.load(Ordering::Relaxed) || !rows.contains(y as u32) {
             return;

@@ -43,9 +43,12 @@ use crate::scene::Scene;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-/// Light paths traced per parallel work item: enough to amortise the
-/// scheduling, few enough to balance two to many threads.
-const PATHS_PER_CHUNK: u64 = 1024;
+/// Light paths traced per parallel job (one job each, not rayon's default
+/// of a few large pieces; see `integrator::pass`): a few hundred
+/// microseconds of tracing, which the scheduling does not notice, and
+/// small enough that a pass's light paths balance across two to many
+/// threads (at 1,024 a 256 × 192 image had six jobs).
+const PATHS_PER_CHUNK: u64 = 128;
 
 /// Mixed into the seed of light paths, so their sample streams are not the
 /// camera samples of the pixel with the same index.
@@ -104,9 +107,11 @@ pub fn add_pass(
     let chunks = paths.div_ceil(PATHS_PER_CHUNK);
     // The film divides every splat by the light paths per pass.
     let lens_scale = paths as f64 / paths.div_ceil(LIGHT_PATHS_PER_LENS_CONNECTION) as f64;
-    let splats: Option<Vec<Vec<(usize, Color)>>> = (0..chunks)
+    let splats: Option<Vec<Vec<(usize, Color)>>> = (0..chunks as usize)
         .into_par_iter()
+        .with_max_len(1)
         .map(|chunk| {
+            let chunk = chunk as u64;
             if cancel.load(Ordering::Relaxed) {
                 return None;
             }

@@ -78,6 +78,16 @@ const EMISSION_SAMPLES: u32 = 4;
 /// Mixed into the seed of the extra emission paths' streams.
 const EMISSION_SEED: u64 = 0xe4e5_5101_7a11_c0de;
 
+/// Most camera paths (pixels) and photons one parallel job traces. Rayon
+/// otherwise cuts a loop into as many pieces as threads, halved once more,
+/// and splits a piece again only when it is stolen: the last piece a
+/// thread starts (a quarter of the work on two threads) runs to its end
+/// while the others wait, and pixels behind glass, or photons through it,
+/// cost many times the rest. Jobs this small cost nothing to schedule
+/// against their tracing and leave at most one of them as the tail.
+const PIXELS_PER_JOB: usize = 256;
+const PHOTONS_PER_JOB: usize = 1024;
+
 /// Least cosine between the geometric normals of a visible point and a photon
 /// hit for the photon to count: rejects photons on another surface that
 /// happens to lie within the radius (the far side of a thin wall, the other
@@ -259,6 +269,7 @@ impl SppmIntegrator {
         samples
             .par_iter_mut()
             .enumerate()
+            .with_max_len(PIXELS_PER_JOB)
             .for_each(|(index, slot)| *slot = sample_pixel(index));
     }
 
@@ -319,6 +330,7 @@ impl SppmIntegrator {
         (0..self.parameters.photons_per_iteration)
             .into_par_iter()
             .with_min_len(64)
+            .with_max_len(PHOTONS_PER_JOB)
             .for_each(|index| {
                 if cancel.load(Ordering::Relaxed) {
                     return;
