@@ -25,6 +25,7 @@
 //!   Other samples are counted as rejected, as NaN ones always were.
 
 use crate::color::{Color, luminance, srgb_encode_8bit};
+use rayon::prelude::*;
 
 /// Fractional bits of the colour sums (see the module doc).
 pub const COLOR_FRACTION_BITS: u32 = 64;
@@ -178,20 +179,30 @@ impl PixelAccumulator {
 
     /// The pixel's estimate: the mean of its samples (black before the first).
     pub fn mean(&self) -> Color {
+        self.mean_of(self.sum())
+    }
+
+    /// [`Self::mean`], given [`Self::sum`].
+    fn mean_of(&self, sum: Color) -> Color {
         if self.count == 0 {
             Color::ZERO
         } else {
-            self.sum() / self.count as f64
+            sum / self.count as f64
         }
     }
 
     /// Standard error of the pixel's mean luminance (unbiased sample variance / n).
     pub fn standard_error(&self) -> f64 {
+        self.standard_error_of(self.sum())
+    }
+
+    /// [`Self::standard_error`], given [`Self::sum`].
+    fn standard_error_of(&self, sum: Color) -> f64 {
         if self.count < 2 {
             return f64::INFINITY;
         }
         let n = self.count as f64;
-        let mean = luminance(self.sum()) / n;
+        let mean = luminance(sum) / n;
         let variance = ((self.luminance_squared_sum() - n * mean * mean) / (n - 1.0)).max(0.0);
         (variance / n).sqrt()
     }
@@ -321,21 +332,42 @@ impl Film {
         self.pixels.iter().map(|p| p.count as u64).sum()
     }
 
-    /// The current estimate, linear.
+    /// The current estimate, linear, with each pixel's noise estimate.
+    ///
+    /// Built in parallel on the current rayon pool, each pixel's sums
+    /// converted once for both values: the viewer builds a frame after
+    /// every pass, and the conversions of the exact integer sums to floats
+    /// are library routines (x86-64 has no instruction for them). Built
+    /// one pixel after another, a 512 × 512 frame took 15 ms, a tenth to a
+    /// fifth of a two-thread pass, with the other thread idle.
     pub fn frame(&self) -> Frame {
+        let light = self.light.as_ref();
+        let (pixels, noise) = self
+            .pixels
+            .par_iter()
+            .enumerate()
+            .with_min_len(FRAME_PIXELS_PER_JOB)
+            .map(|(index, pixel)| {
+                let sum = pixel.sum();
+                let mean = pixel.mean_of(sum);
+                let value = match light {
+                    None => mean,
+                    Some(light) => mean + light.radiance(index, pixel.count),
+                };
+                (value.as_vec3().to_array(), pixel.standard_error_of(sum) as f32)
+            })
+            .unzip();
         Frame {
             width: self.width,
             height: self.height,
-            pixels: match &self.light {
-                None => self.pixels.iter().map(|p| p.mean().as_vec3().to_array()).collect(),
-                Some(light) => (self.pixels.iter().enumerate())
-                    .map(|(i, p)| (p.mean() + light.radiance(i, p.count)).as_vec3().to_array())
-                    .collect(),
-            },
-            noise: self.pixels.iter().map(|p| p.standard_error() as f32).collect(),
+            pixels,
+            noise,
         }
     }
 }
+
+/// Pixels per parallel job of [`Film::frame`]: tens of microseconds each.
+const FRAME_PIXELS_PER_JOB: usize = 4096;
 
 /// A linear-radiance image, row-major from the top-left.
 #[derive(Clone, Debug, Default, PartialEq)]

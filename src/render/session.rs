@@ -516,8 +516,12 @@ impl Worker {
         if render.is_finished() {
             self.mode = SessionState::Finished;
         }
-        let integrator = render.integrator();
-        let (frame, extras) = (integrator.frame(), Extras::of(integrator));
+        // On the render pool: building a frame is a pass over every pixel
+        // (see `Film::frame`), and the pool would otherwise idle through it.
+        let (frame, extras) = self.pool.install(move || {
+            let integrator = render.integrator();
+            (integrator.frame(), Extras::of(integrator))
+        });
         self.publish(Some(frame), extras, false);
     }
 
@@ -531,7 +535,10 @@ impl Worker {
         let mut preview = full.preview(divisor);
         let cancel = &self.cancel;
         if self.pool.install(|| preview.render_pass(scene, camera, cancel)) {
-            self.publish(Some(preview.frame()), Extras::of(preview.as_ref()), true);
+            // (Moved in as `&mut`: an integrator is `Send`, not `Sync`.)
+            let preview = &mut preview;
+            let (frame, extras) = self.pool.install(move || (preview.frame(), Extras::of(preview.as_ref())));
+            self.publish(Some(frame), extras, true);
         }
     }
 

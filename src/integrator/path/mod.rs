@@ -196,7 +196,7 @@ impl Integrator for PathIntegrator {
     }
 
     fn sample_counts(&self) -> Option<Vec<u32>> {
-        Some(self.film.pixels.iter().map(|p| p.count).collect())
+        Some(self.film.pixels.par_iter().map(|p| p.count).collect())
     }
 
     fn rejected_samples(&self) -> u64 {

@@ -492,8 +492,9 @@ impl Integrator for SppmIntegrator {
             Estimate::Progressive(pixels) => Frame {
                 width: self.width,
                 height: self.height,
+                // In parallel, as `Film::frame` (the viewer's frame per iteration).
                 pixels: pixels
-                    .iter()
+                    .par_iter()
                     .map(|p| p.radiance(iterations, photons).as_vec3().to_array())
                     .collect(),
                 noise: Vec::new(),
