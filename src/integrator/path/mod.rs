@@ -41,9 +41,48 @@ pub struct PathIntegrator {
     adaptive_threshold: Option<f64>,
     /// Every pixel has met the adaptive threshold (see `Integrator::converged`).
     converged: bool,
+    /// Adaptive sampling's state after the last pass, for `status`.
+    adaptive: AdaptiveProgress,
     /// Where light paths for caustics are aimed, built at the first pass
     /// that traces them (a render's scene does not change).
     caustic_emission: Option<CausticEmission>,
+}
+
+/// How far adaptive sampling has come, counted after each pass in one
+/// parallel sweep of the film (the viewer shows it after every pass, and
+/// a count one pixel after another took as long as building the frame).
+#[derive(Clone, Copy, Debug, Default)]
+struct AdaptiveProgress {
+    /// Pixels in the render's rows, and how many of them have converged.
+    in_rows: usize,
+    converged: usize,
+    /// Every pixel the render samples has converged.
+    all_sampled_converged: bool,
+}
+
+impl AdaptiveProgress {
+    fn of(film: &Film, sampled: crate::settings::PixelRect, rows: RowSet, threshold: f64) -> Self {
+        let width = film.width as usize;
+        let (in_rows, converged, all_sampled_converged) = film
+            .pixels
+            .par_iter()
+            .enumerate()
+            .with_min_len(4096)
+            .map(|(i, pixel)| {
+                let (x, y) = ((i % width) as u32, (i / width) as u32);
+                if !rows.contains(y) {
+                    return (0, 0, true);
+                }
+                let done = pass::is_converged(pixel, threshold);
+                (1, usize::from(done), done || !sampled.contains(x, y))
+            })
+            .reduce(|| (0, 0, true), |a, b| (a.0 + b.0, a.1 + b.1, a.2 && b.2));
+        Self {
+            in_rows,
+            converged,
+            all_sampled_converged,
+        }
+    }
 }
 
 /// Whether `settings` allow light-traced caustics: asked for, path tracing
@@ -76,6 +115,7 @@ impl PathIntegrator {
             rows: share.rows,
             adaptive_threshold: settings.adaptive_threshold,
             converged: false,
+            adaptive: AdaptiveProgress::default(),
             caustic_emission: None,
         }
     }
@@ -155,22 +195,12 @@ impl Integrator for PathIntegrator {
         };
         if completed {
             self.passes += 1;
-            let (pixels, rows) = (self.settings.sampled_pixels(), self.rows);
-            // A stopped pixel stays stopped (its state no longer changes), so
-            // once all that are sampled are, every later pass would be empty.
-            let width = self.film.width as usize;
-            let sampled = |i: usize| {
-                let (x, y) = ((i % width) as u32, (i / width) as u32);
-                pixels.contains(x, y) && rows.contains(y)
-            };
-            let converged = |threshold| {
-                self.film
-                    .pixels
-                    .par_iter()
-                    .enumerate()
-                    .all(|(i, p)| !sampled(i) || pass::is_converged(p, threshold))
-            };
-            self.converged = self.adaptive_threshold.is_some_and(converged);
+            if let Some(threshold) = self.adaptive_threshold {
+                self.adaptive = AdaptiveProgress::of(&self.film, self.settings.sampled_pixels(), self.rows, threshold);
+                // A stopped pixel stays stopped (its state no longer changes), so
+                // once all that are sampled are, every later pass would be empty.
+                self.converged = self.adaptive.all_sampled_converged;
+            }
         }
         completed
     }
@@ -206,18 +236,83 @@ impl Integrator for PathIntegrator {
     fn status(&self) -> String {
         match self.adaptive_threshold {
             Some(_) if self.converged => "adaptive: converged, 0% of pixels active".to_string(),
-            Some(threshold) => {
-                let width = self.film.width as usize;
-                let (mut total, mut converged) = (0usize, 0usize);
-                let rows = self.film.pixels.chunks(width).enumerate();
-                for (_, row) in rows.filter(|(y, _)| self.rows.contains(*y as u32)) {
-                    total += row.len();
-                    converged += row.iter().filter(|p| pass::is_converged(p, threshold)).count();
-                }
-                let active = 100.0 * (1.0 - converged as f64 / total.max(1) as f64);
+            Some(_) => {
+                let AdaptiveProgress { in_rows, converged, .. } = self.adaptive;
+                let active = 100.0 * (1.0 - converged as f64 / in_rows.max(1) as f64);
                 format!("adaptive: {active:.0}% of pixels active")
             }
             None => String::new(),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::color::Color;
+    use crate::settings::PixelRect;
+
+    /// The parallel sweep counts what a plain count over the film does: a
+    /// film of pixels that have converged (constant samples past the
+    /// minimum count), pixels still noisy and pixels never sampled, with a
+    /// row set and a sampled rectangle that each leave some out.
+    #[test]
+    fn adaptive_progress_counts_what_a_plain_count_does() {
+        let (width, height) = (97, 61);
+        let mut film = Film::new(width, height);
+        for (i, pixel) in film.pixels.iter_mut().enumerate() {
+            let samples = (crate::sampler::mix64(i as u64) % 3) as u32 * 20;
+            for k in 0..samples {
+                let value = if i % 5 == 0 { 1.0 + (k % 2) as f64 } else { 0.5 };
+                pixel.add(Color::splat(value));
+            }
+        }
+        let threshold = 0.05;
+        for rows in [RowSet::ALL, RowSet { first: 1, step: 3 }] {
+            for sampled in [
+                PixelRect::full(width, height),
+                PixelRect {
+                    x0: 10,
+                    y0: 5,
+                    x1: 60,
+                    y1: 40,
+                },
+            ] {
+                let progress = AdaptiveProgress::of(&film, sampled, rows, threshold);
+                let (mut in_rows, mut converged, mut all) = (0, 0, true);
+                for (i, pixel) in film.pixels.iter().enumerate() {
+                    let (x, y) = ((i as u32 % width), (i as u32 / width));
+                    if rows.contains(y) {
+                        in_rows += 1;
+                        let done = pass::is_converged(pixel, threshold);
+                        converged += usize::from(done);
+                        all &= done || !sampled.contains(x, y);
+                    }
+                }
+                assert_eq!(
+                    (progress.in_rows, progress.converged, progress.all_sampled_converged),
+                    (in_rows, converged, all)
+                );
+                assert!(
+                    converged > 0 && converged < in_rows,
+                    "the film must mix converged and active pixels"
+                );
+            }
+        }
+        // A film where every sampled pixel converged, the rest never sampled.
+        let mut film = Film::new(8, 4);
+        for pixel in &mut film.pixels[..16] {
+            for _ in 0..pass::ADAPTIVE_MIN_SAMPLES {
+                pixel.add(Color::splat(0.25));
+            }
+        }
+        let top = PixelRect {
+            x0: 0,
+            y0: 0,
+            x1: 8,
+            y1: 2,
+        };
+        assert!(AdaptiveProgress::of(&film, top, RowSet::ALL, threshold).all_sampled_converged);
+        assert!(!AdaptiveProgress::of(&film, PixelRect::full(8, 4), RowSet::ALL, threshold).all_sampled_converged);
     }
 }
