@@ -26,6 +26,7 @@
 
 use crate::color::{Color, luminance, srgb_encode_8bit};
 use rayon::prelude::*;
+use std::ops::Range;
 
 /// Fractional bits of the colour sums (see the module doc).
 pub const COLOR_FRACTION_BITS: u32 = 64;
@@ -342,21 +343,10 @@ impl Film {
     /// frame took 15 ms, a tenth to a fifth of a two-thread pass, while
     /// the render pool waited.
     pub fn frame(&self) -> Frame {
-        let light = self.light.as_ref();
-        let (pixels, noise) = self
-            .pixels
-            .par_iter()
-            .enumerate()
+        let (pixels, noise) = (0..self.pixels.len())
+            .into_par_iter()
             .with_min_len(FRAME_PIXELS_PER_JOB)
-            .map(|(index, pixel)| {
-                let sum = pixel.sum();
-                let mean = pixel.mean_of(sum);
-                let value = match light {
-                    None => mean,
-                    Some(light) => mean + light.radiance(index, pixel.count),
-                };
-                (value.as_vec3().to_array(), pixel.standard_error_of(sum) as f32)
-            })
+            .map(|index| self.estimate(index))
             .unzip();
         Frame {
             width: self.width,
@@ -364,6 +354,42 @@ impl Film {
             pixels,
             noise,
         }
+    }
+
+    /// The estimate in `columns` × `rows` over a copy of `backdrop`, which
+    /// has the film's size: what the viewer shows during a region render
+    /// (the region over the image of before), computing only the region's
+    /// pixels, as [`Film::frame`] does them. A backdrop without a noise
+    /// estimate gets an unknown (infinite) one outside the region.
+    pub fn frame_over(&self, backdrop: &Frame, columns: Range<usize>, rows: Range<usize>) -> Frame {
+        let mut out = backdrop.clone();
+        if out.noise.len() != out.pixels.len() {
+            out.noise = vec![f32::INFINITY; out.pixels.len()];
+        }
+        let width = self.width as usize;
+        (out.pixels.par_chunks_mut(width).zip(out.noise.par_chunks_mut(width)))
+            .enumerate()
+            .filter(|(y, _)| rows.contains(y))
+            .for_each(|(y, (pixels, noise))| {
+                for x in columns.clone() {
+                    (pixels[x], noise[x]) = self.estimate(y * width + x);
+                }
+            });
+        out
+    }
+
+    /// Pixel `index`'s estimate (camera samples and light paths) and the
+    /// standard error of its camera samples' luminance, its sums converted
+    /// once for both.
+    fn estimate(&self, index: usize) -> ([f32; 3], f32) {
+        let pixel = &self.pixels[index];
+        let sum = pixel.sum();
+        let mean = pixel.mean_of(sum);
+        let value = match &self.light {
+            None => mean,
+            Some(light) => mean + light.radiance(index, pixel.count),
+        };
+        (value.as_vec3().to_array(), pixel.standard_error_of(sum) as f32)
     }
 }
 
@@ -439,6 +465,83 @@ impl Frame {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A film with light splats and pixels of 0, 1 and several samples, so
+    /// every branch of a pixel's estimate is taken.
+    fn varied_film(width: u32, height: u32) -> Film {
+        let mut film = Film::new(width, height);
+        film.light = Some(LightSplats::new(7, film.pixels.len()));
+        for index in 0..film.pixels.len() {
+            let samples = index % 4;
+            for k in 0..samples {
+                film.pixels[index].add(Color::new(0.1 * k as f64, 0.5, index as f64 / 100.0));
+            }
+            if let Some(light) = film.light.as_mut().filter(|_| index % 3 == 0) {
+                assert!(light.add(index, Color::new(0.25, 0.0, 1.5)));
+            }
+        }
+        film
+    }
+
+    /// The frame, built in parallel, holds each pixel's mean (plus its
+    /// light splats) and standard error exactly as the accumulator gives
+    /// them one by one.
+    #[test]
+    fn frames_hold_each_pixels_estimate() {
+        let film = varied_film(67, 45);
+        let frame = film.frame();
+        let light = film.light.as_ref().expect("the film has light splats");
+        for (index, pixel) in film.pixels.iter().enumerate() {
+            let value = pixel.mean() + light.radiance(index, pixel.count);
+            assert_eq!(frame.pixels[index], value.as_vec3().to_array(), "pixel {index}");
+            assert_eq!(
+                frame.noise[index].to_bits(),
+                (pixel.standard_error() as f32).to_bits(),
+                "pixel {index}"
+            );
+        }
+    }
+
+    /// A region over a backdrop takes the film's estimate inside the region
+    /// and the backdrop's pixels and noise outside it; a backdrop without a
+    /// noise estimate gets an infinite one.
+    #[test]
+    fn a_region_over_a_backdrop_is_the_frame_inside_and_the_backdrop_outside() {
+        let (width, height) = (67, 45);
+        let film = varied_film(width, height);
+        let full = film.frame();
+        let count = (width * height) as usize;
+        let backdrop = Frame {
+            width,
+            height,
+            pixels: (0..count).map(|i| [i as f32, -1.0, 2.0]).collect(),
+            noise: (0..count).map(|i| i as f32 * 0.5).collect(),
+        };
+        let without_noise = Frame {
+            noise: Vec::new(),
+            ..backdrop.clone()
+        };
+        let (columns, rows) = (5..40, 3..31);
+        for backdrop in [&backdrop, &without_noise] {
+            let out = film.frame_over(backdrop, columns.clone(), rows.clone());
+            assert_eq!((out.width, out.height), (width, height));
+            for index in 0..count {
+                let (x, y) = (index % width as usize, index / width as usize);
+                if columns.contains(&x) && rows.contains(&y) {
+                    assert_eq!(
+                        (out.pixels[index], out.noise[index].to_bits()),
+                        (full.pixels[index], full.noise[index].to_bits())
+                    );
+                } else {
+                    let noise = backdrop.noise.get(index).copied().unwrap_or(f32::INFINITY);
+                    assert_eq!(
+                        (out.pixels[index], out.noise[index].to_bits()),
+                        (backdrop.pixels[index], noise.to_bits())
+                    );
+                }
+            }
+        }
+    }
 
     #[test]
     fn accumulator_mean_and_error() {

@@ -518,9 +518,25 @@ impl Worker {
         }
         // On the render pool: building a frame is a pass over every pixel
         // (see `Film::frame`), and the pool would otherwise idle through it.
+        let (width, height) = (self.settings.width, self.settings.height);
+        let region = self.settings.region.map(|r| r.pixels(width, height));
+        let backdrop = self.backdrop.as_deref();
         let (frame, extras) = self.pool.install(move || {
             let integrator = render.integrator();
-            (integrator.frame(), Extras::of(integrator))
+            let frame = match (region, backdrop, integrator.film()) {
+                // A region render shows its pixels over the image of before:
+                // only they are computed, not the whole film (most of a pass's
+                // time when the region is small).
+                (Some(region), Some(backdrop), Some(film)) if (backdrop.width, backdrop.height) == (width, height) => film
+                    .frame_over(
+                        backdrop,
+                        region.x0 as usize..region.x1 as usize,
+                        region.y0 as usize..region.y1 as usize,
+                    ),
+                (Some(region), Some(backdrop), _) => composite(backdrop, integrator.frame(), region),
+                _ => integrator.frame(),
+            };
+            (frame, Extras::of(integrator))
         });
         self.publish(Some(frame), extras, false);
     }
@@ -583,11 +599,9 @@ impl Worker {
                 let mut settings = self.settings.clone();
                 settings.width = frame.width;
                 settings.height = frame.height;
+                // (A region render's frame comes composited over its backdrop.)
                 let region = settings.region.map(|r| r.pixels(frame.width, frame.height));
-                let frame = Arc::new(match (region, &self.backdrop) {
-                    (Some(region), Some(backdrop)) => composite(backdrop, frame, region),
-                    _ => frame,
-                });
+                let frame = Arc::new(frame);
                 self.last_frame = Some(Arc::clone(&frame));
                 Some(FrameInfo {
                     frame,
