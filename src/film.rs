@@ -340,8 +340,8 @@ impl Film {
     /// every pass, and the conversions of the exact integer sums to floats
     /// are library routines (x86-64 has no instruction for them). Built
     /// one pixel after another on the viewer's render thread, a 512 × 512
-    /// frame took 15 ms, a tenth to a fifth of a two-thread pass, while
-    /// the render pool waited.
+    /// frame took 15 ms, an eighth to a quarter of a two-thread pass's
+    /// time, while the render pool waited.
     pub fn frame(&self) -> Frame {
         let (pixels, noise) = (0..self.pixels.len())
             .into_par_iter()
