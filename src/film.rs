@@ -359,23 +359,9 @@ impl Film {
     /// The estimate in `columns` × `rows` over a copy of `backdrop`, which
     /// has the film's size: what the viewer shows during a region render
     /// (the region over the image of before), computing only the region's
-    /// pixels, as [`Film::frame`] does them. A backdrop without a noise
-    /// estimate gets an unknown (infinite) one outside the region.
+    /// pixels, as [`Film::frame`] does them.
     pub fn frame_over(&self, backdrop: &Frame, columns: Range<usize>, rows: Range<usize>) -> Frame {
-        let mut out = backdrop.clone();
-        if out.noise.len() != out.pixels.len() {
-            out.noise = vec![f32::INFINITY; out.pixels.len()];
-        }
-        let width = self.width as usize;
-        (out.pixels.par_chunks_mut(width).zip(out.noise.par_chunks_mut(width)))
-            .enumerate()
-            .filter(|(y, _)| rows.contains(y))
-            .for_each(|(y, (pixels, noise))| {
-                for x in columns.clone() {
-                    (pixels[x], noise[x]) = self.estimate(y * width + x);
-                }
-            });
-        out
+        backdrop.with_region(columns, rows, |index| self.estimate(index))
     }
 
     /// Pixel `index`'s estimate (camera samples and light paths) and the
@@ -409,6 +395,33 @@ pub struct Frame {
     pub pixels: Vec<[f32; 3]>,
     /// Per-pixel standard error of mean luminance; empty when unknown.
     pub noise: Vec<f32>,
+}
+
+impl Frame {
+    /// A copy with the pixels in `columns` × `rows` replaced by
+    /// `value(index)` (colour and noise), set in parallel by rows. A frame
+    /// without a noise estimate gets an unknown (infinite) one outside them.
+    pub fn with_region(
+        &self,
+        columns: Range<usize>,
+        rows: Range<usize>,
+        value: impl Fn(usize) -> ([f32; 3], f32) + Sync,
+    ) -> Frame {
+        let mut out = self.clone();
+        if out.noise.len() != out.pixels.len() {
+            out.noise = vec![f32::INFINITY; out.pixels.len()];
+        }
+        let width = self.width as usize;
+        (out.pixels.par_chunks_mut(width).zip(out.noise.par_chunks_mut(width)))
+            .enumerate()
+            .filter(|(y, _)| rows.contains(y))
+            .for_each(|(y, (pixels, noise))| {
+                for x in columns.clone() {
+                    (pixels[x], noise[x]) = value(y * width + x);
+                }
+            });
+        out
+    }
 }
 
 /// How linear radiance becomes a displayable value in [0, 1].

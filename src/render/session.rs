@@ -523,17 +523,21 @@ impl Worker {
         let backdrop = self.backdrop.as_deref();
         let (frame, extras) = self.pool.install(move || {
             let integrator = render.integrator();
-            let frame = match (region, backdrop, integrator.film()) {
+            let frame = match (region, backdrop) {
                 // A region render shows its pixels over the image of before:
                 // only they are computed, not the whole film (most of a pass's
                 // time when the region is small).
-                (Some(region), Some(backdrop), Some(film)) if (backdrop.width, backdrop.height) == (width, height) => film
-                    .frame_over(
-                        backdrop,
-                        region.x0 as usize..region.x1 as usize,
-                        region.y0 as usize..region.y1 as usize,
-                    ),
-                (Some(region), Some(backdrop), _) => composite(backdrop, integrator.frame(), region),
+                (Some(region), Some(backdrop)) if (backdrop.width, backdrop.height) == (width, height) => {
+                    let (columns, rows) = (region.x0 as usize..region.x1 as usize, region.y0 as usize..region.y1 as usize);
+                    match integrator.film() {
+                        Some(film) => film.frame_over(backdrop, columns, rows),
+                        None => {
+                            let frame = integrator.frame();
+                            let noise = |i: usize| frame.noise.get(i).copied().unwrap_or(f32::INFINITY);
+                            backdrop.with_region(columns, rows, |i| (frame.pixels[i], noise(i)))
+                        }
+                    }
+                }
                 _ => integrator.frame(),
             };
             (frame, Extras::of(integrator))
@@ -659,28 +663,6 @@ impl Extras {
             noise_estimated: integrator.estimates_noise(),
         }
     }
-}
-
-/// `frame`'s pixels inside `region` over a copy of `backdrop` (when the two
-/// have the same size; otherwise the frame as it is).
-fn composite(backdrop: &Frame, frame: Frame, region: PixelRect) -> Frame {
-    if (backdrop.width, backdrop.height) != (frame.width, frame.height) {
-        return frame;
-    }
-    let mut out = backdrop.clone();
-    if out.noise.len() != out.pixels.len() {
-        out.noise = vec![f32::INFINITY; out.pixels.len()];
-    }
-    let width = frame.width as usize;
-    for y in region.y0 as usize..region.y1 as usize {
-        let row = y * width + region.x0 as usize..y * width + region.x1 as usize;
-        out.pixels[row.clone()].copy_from_slice(&frame.pixels[row.clone()]);
-        match frame.noise.get(row.clone()) {
-            Some(noise) => out.noise[row].copy_from_slice(noise),
-            None => out.noise[row].fill(f32::INFINITY),
-        }
-    }
-    out
 }
 
 #[cfg(test)]

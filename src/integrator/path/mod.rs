@@ -39,9 +39,8 @@ pub struct PathIntegrator {
     /// Rows this render samples.
     rows: RowSet,
     adaptive_threshold: Option<f64>,
-    /// Every pixel has met the adaptive threshold (see `Integrator::converged`).
-    converged: bool,
-    /// Adaptive sampling's state after the last pass, for `status`.
+    /// Adaptive sampling's state after the last pass: whether every pixel
+    /// has met the threshold (`Integrator::converged`), and `status`.
     adaptive: AdaptiveProgress,
     /// Where light paths for caustics are aimed, built at the first pass
     /// that traces them (a render's scene does not change).
@@ -114,7 +113,6 @@ impl PathIntegrator {
             first_sample: share.samples.start,
             rows: share.rows,
             adaptive_threshold: settings.adaptive_threshold,
-            converged: false,
             adaptive: AdaptiveProgress::default(),
             caustic_emission: None,
         }
@@ -196,17 +194,16 @@ impl Integrator for PathIntegrator {
         if completed {
             self.passes += 1;
             if let Some(threshold) = self.adaptive_threshold {
-                self.adaptive = AdaptiveProgress::of(&self.film, self.settings.sampled_pixels(), self.rows, threshold);
                 // A stopped pixel stays stopped (its state no longer changes), so
                 // once all that are sampled are, every later pass would be empty.
-                self.converged = self.adaptive.all_sampled_converged;
+                self.adaptive = AdaptiveProgress::of(&self.film, self.settings.sampled_pixels(), self.rows, threshold);
             }
         }
         completed
     }
 
     fn converged(&self) -> bool {
-        self.converged
+        self.adaptive.all_sampled_converged
     }
 
     fn preview(&self, divisor: u32) -> Box<dyn Integrator> {
@@ -242,7 +239,7 @@ impl Integrator for PathIntegrator {
 
     fn status(&self) -> String {
         match self.adaptive_threshold {
-            Some(_) if self.converged => "adaptive: converged, 0% of pixels active".to_string(),
+            Some(_) if self.adaptive.all_sampled_converged => "adaptive: converged, 0% of pixels active".to_string(),
             Some(_) => {
                 let AdaptiveProgress { in_rows, converged, .. } = self.adaptive;
                 let active = 100.0 * (1.0 - converged as f64 / in_rows.max(1) as f64);

@@ -78,13 +78,10 @@ const EMISSION_SAMPLES: u32 = 4;
 /// Mixed into the seed of the extra emission paths' streams.
 const EMISSION_SEED: u64 = 0xe4e5_5101_7a11_c0de;
 
-/// Most camera paths (pixels) and photons one parallel job traces. Rayon
-/// otherwise cuts a loop into as many pieces as threads, halved once more,
-/// and splits a piece again only when it is stolen: the last piece a
-/// thread starts (a quarter of the work on two threads) runs to its end
-/// while the others wait, and pixels behind glass, or photons through it,
-/// cost many times the rest. Jobs this small cost nothing to schedule
-/// against their tracing and leave at most one of them as the tail.
+/// Most camera paths (pixels) and photons one parallel job traces, so a
+/// pass does not end on one thread's long last piece (see
+/// `integrator::pass`): pixels behind glass, and photons through it, cost
+/// many times the rest.
 const PIXELS_PER_JOB: usize = 256;
 const PHOTONS_PER_JOB: usize = 1024;
 
