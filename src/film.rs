@@ -379,8 +379,9 @@ impl Film {
     }
 }
 
-/// Pixels per parallel job of [`Film::frame`]: tens of microseconds each.
-const FRAME_PIXELS_PER_JOB: usize = 4096;
+/// Pixels per parallel job of a sweep over the film ([`Film::frame`],
+/// adaptive sampling's progress): tens of microseconds each.
+pub(crate) const FRAME_PIXELS_PER_JOB: usize = 4096;
 
 /// A linear-radiance image, row-major from the top-left.
 #[derive(Clone, Debug, Default, PartialEq)]

@@ -66,7 +66,7 @@ impl AdaptiveProgress {
             .pixels
             .par_iter()
             .enumerate()
-            .with_min_len(4096)
+            .with_min_len(crate::film::FRAME_PIXELS_PER_JOB)
             .map(|(i, pixel)| {
                 let (x, y) = ((i % width) as u32, (i / width) as u32);
                 if !rows.contains(y) {
