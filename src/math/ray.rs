@@ -31,6 +31,7 @@ impl Ray {
     /// A ray leaving a surface point whose position carries the absolute
     /// error bound `point_error`, offset along the normal so that it cannot
     /// hit the same surface again.
+    #[inline(always)]
     pub fn spawn(point: DVec3, point_error: DVec3, normal: DVec3, direction: DVec3) -> Self {
         Self {
             origin: offset_ray_origin(point, point_error, normal, direction),
@@ -58,6 +59,7 @@ pub const fn gamma(n: u32) -> f64 {
 /// per call on the Cornell box. The three coordinates go through together
 /// in SIMD lanes; done one by one in scalar code the bit operations cost
 /// more than the mispredictions saved.
+#[inline(always)]
 pub fn offset_ray_origin(point: DVec3, point_error: DVec3, normal: DVec3, direction: DVec3) -> DVec3 {
     let distance = normal.abs().dot(point_error);
     // Negating a float flips its sign bit: a mask of that bit negates the

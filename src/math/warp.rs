@@ -32,6 +32,7 @@ fn select(condition: bool, a: f64, b: f64) -> f64 {
 }
 
 /// Cosine-weighted direction on the +z hemisphere (Malley's method).
+#[inline]
 pub fn square_to_cosine_hemisphere(u: DVec2) -> DVec3 {
     let d = square_to_concentric_disk(u);
     let z = (1.0 - d.length_squared()).max(0.0).sqrt();
