@@ -19,7 +19,7 @@ pub use progress::{LoadStage, load_scene_file_with_progress};
 pub use similarity::{Similarity, load_scene_str_placed};
 pub use specular_balls::{MAX_SPECULAR_BALLS, SpecularBall};
 
-use crate::accel::{BuildPrimitive, Bvh, LeafKind};
+use crate::accel::{BuildPrimitive, Bvh, Leaf, LeafKind};
 use crate::color::Color;
 use crate::geometry::clipped_sphere::clip_emitters;
 use crate::geometry::spheres::Spheres;
@@ -434,37 +434,47 @@ impl Scene {
         let mut triangle_ray: Option<TriangleRay> = None;
         let mut nearest = Nearest::Nothing;
         let mut t = t_max;
-        self.bvh.traverse(ray, &mut t, |leaf, t_max| {
+        let prefetch_leaf = |leaf: Leaf| {
             if leaf.kind == TRIANGLE_LEAF {
-                let triangle_ray = triangle_ray.get_or_insert_with(|| TriangleRay::new(ray));
-                if let Some(found) = self.triangles.intersect_leaf(triangle_ray, leaf.first, leaf.count, *t_max) {
-                    *t_max = found.hit.t;
-                    nearest = Nearest::Triangle(found);
-                }
-            } else if leaf.kind == SPHERE_LEAF {
-                if let Some(found) = self.spheres.intersect_leaf(ray, leaf.first, leaf.count, *t_max) {
-                    *t_max = found.t;
-                    nearest = Nearest::Shape(self.first_sphere + found.index, ShapeHit::Sphere(found.t));
-                }
-            } else {
-                for index in leaf.first..leaf.first + leaf.count {
-                    if SKIP && index == skipped {
-                        continue;
-                    }
-                    let shape = &self.shapes[index as usize].shape;
-                    if let Shape::Revolution(revolution) = shape {
-                        if let Some(hit) = revolution.intersect(ray, *t_max) {
-                            *t_max = hit.t;
-                            nearest = Nearest::Record(Intersection { hit, primitive: index });
-                        }
-                    } else if let Some(hit) = shape.nearest_hit(ray, *t_max) {
-                        *t_max = hit.t();
-                        nearest = Nearest::Shape(index, hit);
-                    }
-                }
+                self.triangles.prefetch_leaf(leaf.first);
             }
-            false
-        });
+        };
+        self.bvh.traverse_prefetching(
+            ray,
+            &mut t,
+            |leaf, t_max| {
+                if leaf.kind == TRIANGLE_LEAF {
+                    let triangle_ray = triangle_ray.get_or_insert_with(|| TriangleRay::new(ray));
+                    if let Some(found) = self.triangles.intersect_leaf(triangle_ray, leaf.first, leaf.count, *t_max) {
+                        *t_max = found.hit.t;
+                        nearest = Nearest::Triangle(found);
+                    }
+                } else if leaf.kind == SPHERE_LEAF {
+                    if let Some(found) = self.spheres.intersect_leaf(ray, leaf.first, leaf.count, *t_max) {
+                        *t_max = found.t;
+                        nearest = Nearest::Shape(self.first_sphere + found.index, ShapeHit::Sphere(found.t));
+                    }
+                } else {
+                    for index in leaf.first..leaf.first + leaf.count {
+                        if SKIP && index == skipped {
+                            continue;
+                        }
+                        let shape = &self.shapes[index as usize].shape;
+                        if let Shape::Revolution(revolution) = shape {
+                            if let Some(hit) = revolution.intersect(ray, *t_max) {
+                                *t_max = hit.t;
+                                nearest = Nearest::Record(Intersection { hit, primitive: index });
+                            }
+                        } else if let Some(hit) = shape.nearest_hit(ray, *t_max) {
+                            *t_max = hit.t();
+                            nearest = Nearest::Shape(index, hit);
+                        }
+                    }
+                }
+                false
+            },
+            prefetch_leaf,
+        );
         match nearest {
             Nearest::Nothing => None,
             Nearest::Triangle(found) => {
@@ -509,20 +519,30 @@ impl Scene {
         let mut triangle_ray: Option<TriangleRay> = None;
         let mut t = t_max;
         let mut found = false;
-        self.bvh.traverse_unordered(ray, &mut t, |leaf, t_max| {
-            found = if leaf.kind == TRIANGLE_LEAF {
-                let triangle_ray = triangle_ray.get_or_insert_with(|| TriangleRay::new(ray));
-                self.triangles.occludes_leaf(triangle_ray, leaf.first, leaf.count, *t_max)
-            } else if leaf.kind == SPHERE_LEAF {
-                self.spheres.occludes_leaf(ray, leaf.first, leaf.count, *t_max)
-            } else {
-                (leaf.first..leaf.first + leaf.count).any(|index| {
-                    !(SKIP && (index == skipped || index == target))
-                        && self.shapes[index as usize].shape.hit_distance(ray, *t_max).is_some()
-                })
-            };
-            found
-        });
+        let prefetch_leaf = |leaf: Leaf| {
+            if leaf.kind == TRIANGLE_LEAF {
+                self.triangles.prefetch_leaf(leaf.first);
+            }
+        };
+        self.bvh.traverse_unordered(
+            ray,
+            &mut t,
+            |leaf, t_max| {
+                found = if leaf.kind == TRIANGLE_LEAF {
+                    let triangle_ray = triangle_ray.get_or_insert_with(|| TriangleRay::new(ray));
+                    self.triangles.occludes_leaf(triangle_ray, leaf.first, leaf.count, *t_max)
+                } else if leaf.kind == SPHERE_LEAF {
+                    self.spheres.occludes_leaf(ray, leaf.first, leaf.count, *t_max)
+                } else {
+                    (leaf.first..leaf.first + leaf.count).any(|index| {
+                        !(SKIP && (index == skipped || index == target))
+                            && self.shapes[index as usize].shape.hit_distance(ray, *t_max).is_some()
+                    })
+                };
+                found
+            },
+            prefetch_leaf,
+        );
         found
     }
 
