@@ -31,6 +31,8 @@ impl Ray {
     /// A ray leaving a surface point whose position carries the absolute
     /// error bound `point_error`, offset along the normal so that it cannot
     /// hit the same surface again.
+    // Always inlined, like `offset_ray_origin`: out of line, its vectors
+    // went through memory (see there).
     #[inline(always)]
     pub fn spawn(point: DVec3, point_error: DVec3, normal: DVec3, direction: DVec3) -> Self {
         Self {
@@ -59,6 +61,12 @@ pub const fn gamma(n: u32) -> f64 {
 /// per call on the Cornell box. The three coordinates go through together
 /// in SIMD lanes; done one by one in scalar code the bit operations cost
 /// more than the mispredictions saved.
+///
+/// Always inlined: called out of line it received its vectors through
+/// memory, and reading the normal's y and z as one 16-byte pair, which
+/// the caller had written as two smaller stores, waited for those stores
+/// to reach the cache (a load spanning two stores cannot be forwarded from
+/// the store buffer): a third of its time on an AMD EPYC (docs/performance.md).
 #[inline(always)]
 pub fn offset_ray_origin(point: DVec3, point_error: DVec3, normal: DVec3, direction: DVec3) -> DVec3 {
     let distance = normal.abs().dot(point_error);

@@ -32,6 +32,8 @@ fn select(condition: bool, a: f64, b: f64) -> f64 {
 }
 
 /// Cosine-weighted direction on the +z hemisphere (Malley's method).
+/// Inlined, so the direction reaches the caller in registers, not through
+/// a returned record read back in pieces.
 #[inline]
 pub fn square_to_cosine_hemisphere(u: DVec2) -> DVec3 {
     let d = square_to_concentric_disk(u);

@@ -434,11 +434,6 @@ impl Scene {
         let mut triangle_ray: Option<TriangleRay> = None;
         let mut nearest = Nearest::Nothing;
         let mut t = t_max;
-        let prefetch_leaf = |leaf: Leaf| {
-            if leaf.kind == TRIANGLE_LEAF {
-                self.triangles.prefetch_leaf(leaf.first);
-            }
-        };
         self.bvh.traverse_prefetching(
             ray,
             &mut t,
@@ -473,7 +468,7 @@ impl Scene {
                 }
                 false
             },
-            prefetch_leaf,
+            |leaf| self.prefetch_leaf(leaf),
         );
         match nearest {
             Nearest::Nothing => None,
@@ -519,11 +514,6 @@ impl Scene {
         let mut triangle_ray: Option<TriangleRay> = None;
         let mut t = t_max;
         let mut found = false;
-        let prefetch_leaf = |leaf: Leaf| {
-            if leaf.kind == TRIANGLE_LEAF {
-                self.triangles.prefetch_leaf(leaf.first);
-            }
-        };
         self.bvh.traverse_unordered(
             ray,
             &mut t,
@@ -541,9 +531,19 @@ impl Scene {
                 };
                 found
             },
-            prefetch_leaf,
+            |leaf| self.prefetch_leaf(leaf),
         );
         found
+    }
+
+    /// Starts loading the primitives of a leaf the traversal deferred (in
+    /// a tree larger than the caches): a triangle leaf's vertex block. The
+    /// other kinds belong to small scenes, whose data stays cached.
+    #[inline(always)]
+    fn prefetch_leaf(&self, leaf: Leaf) {
+        if leaf.kind == TRIANGLE_LEAF {
+            self.triangles.prefetch_leaf(leaf.first);
+        }
     }
 
     /// The acceleration structure, for statistics and benchmarks.
