@@ -200,9 +200,8 @@ impl Lights {
             Some(clipped) => clipped.sample_from(reference, u),
             None => source.emitter(light.primitive).sample_from(reference, u),
         }?;
-        let to_light = sample.point - reference;
-        let distance = to_light.length();
-        let wi = to_light / distance;
+        let distance = sample.distance;
+        let wi = (sample.point - reference) / distance;
         let facing = sample.normal.dot(-wi) > 0.0;
         if !(facing || light.two_sided) || !sample.pdf.is_finite() || sample.pdf <= 0.0 {
             return None;

@@ -14,6 +14,8 @@ pub struct ShapeSample {
     pub point_error: DVec3,
     /// Unit outward normal at `point`.
     pub normal: DVec3,
+    /// |`point` − the reference point|.
+    pub distance: f64,
     /// Density per unit solid angle at the reference point.
     pub pdf: f64,
 }
@@ -24,7 +26,10 @@ pub struct ShapeSample {
 pub fn by_area(sample: AreaSample, area: f64, reference: DVec3) -> Option<ShapeSample> {
     let to_surface = sample.point - reference;
     let distance_squared = to_surface.length_squared();
-    let cos_surface = sample.normal.dot(-to_surface.normalize()).abs();
+    // One square root for the direction and the distance the caller needs
+    // (`to_surface * (1 / distance)` is `normalize`'s own arithmetic).
+    let distance = distance_squared.sqrt();
+    let cos_surface = sample.normal.dot(-(to_surface * (1.0 / distance))).abs();
     if cos_surface == 0.0 || distance_squared == 0.0 {
         return None;
     }
@@ -32,6 +37,7 @@ pub fn by_area(sample: AreaSample, area: f64, reference: DVec3) -> Option<ShapeS
         point: sample.point,
         point_error: sample.point_error,
         normal: sample.normal,
+        distance,
         pdf: distance_squared / (cos_surface * area),
     })
 }

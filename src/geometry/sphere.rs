@@ -144,6 +144,7 @@ impl Sphere {
             point,
             point_error: gamma(5) * (point.abs() + self.center.abs()),
             normal,
+            distance: (point - reference).length(),
             pdf,
         })
     }

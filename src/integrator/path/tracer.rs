@@ -11,7 +11,7 @@ use crate::color::Color;
 use crate::geometry::{Bounce, SurfaceHit};
 use crate::integrator::bsdf_inputs::bsdf_inputs_drawn;
 use crate::material::{ShadingPoint, Transport};
-use crate::math::{Frame as ShadingFrame, Ray, warp::power_heuristic};
+use crate::math::{Frame as ShadingFrame, Ray, ray::offset_ray_origin, warp::power_heuristic};
 use crate::sampler::{Deferred1d, Sampler};
 use crate::scene::{Leaving, Scene};
 use crate::settings::{IntegratorKind, RenderSettings};
@@ -237,10 +237,20 @@ impl PathTracer {
                     let wi = frame.to_local(light.wi);
                     let f = material.eval(wo, wi, &at) * wi.z.abs();
                     if f != Color::ZERO {
-                        let shadow = Ray::spawn(hit.point, hit.point_error, hit.geometric_normal, light.wi);
-                        let distance = (light.point - shadow.origin).length();
-                        // Stop short of the light by far more than its point error.
-                        let t_max = distance * (1.0 - 1e-9) - light.point_error.length();
+                        // The light sample's direction is unit already: normalising
+                        // it again (`Ray::spawn`) would put a square root and a
+                        // division between the sample and the shadow ray's traversal.
+                        let shadow = Ray {
+                            origin: offset_ray_origin(hit.point, hit.point_error, hit.geometric_normal, light.wi),
+                            direction: light.wi,
+                        };
+                        // Stop short of the light by far more than its point error,
+                        // from the light sample's own distance less the origin's
+                        // offset: both bounded by 1-norms, which are no smaller
+                        // than lengths and need no square root. So the segment
+                        // ends no later than |light − origin| − |error| would.
+                        let offset = (shadow.origin - hit.point).abs().element_sum();
+                        let t_max = light.distance * (1.0 - 1e-9) - light.point_error.abs().element_sum() - offset;
                         if !scene.occluded_between(&shadow, t_max, here, scene.leaving(light.primitive)) {
                             let weight = power_heuristic(light.pdf, material.pdf(wo, wi));
                             let f = C::from_rgb(f, wavelengths);
