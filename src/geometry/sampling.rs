@@ -26,11 +26,11 @@ pub struct ShapeSample {
 pub fn by_area(sample: AreaSample, area: f64, reference: DVec3) -> Option<ShapeSample> {
     let to_surface = sample.point - reference;
     let distance_squared = to_surface.length_squared();
-    // One square root for the direction and the distance the caller needs
-    // (`to_surface * (1 / distance)` is `normalize`'s own arithmetic).
     let distance = distance_squared.sqrt();
-    let cos_surface = sample.normal.dot(-(to_surface * (1.0 / distance))).abs();
-    if cos_surface == 0.0 || distance_squared == 0.0 {
+    // d²/(|cos θ| A) with |cos θ| = |n·(p − x)|/d: d³/(|n·(p − x)| A), one
+    // division after the square root instead of three.
+    let projected = sample.normal.dot(to_surface).abs();
+    if projected == 0.0 || distance_squared == 0.0 {
         return None;
     }
     Some(ShapeSample {
@@ -38,7 +38,7 @@ pub fn by_area(sample: AreaSample, area: f64, reference: DVec3) -> Option<ShapeS
         point_error: sample.point_error,
         normal: sample.normal,
         distance,
-        pdf: distance_squared / (cos_surface * area),
+        pdf: distance_squared * distance / (projected * area),
     })
 }
 
@@ -47,9 +47,10 @@ pub fn by_area(sample: AreaSample, area: f64, reference: DVec3) -> Option<ShapeS
 pub fn pdf_by_area(area: f64, reference: DVec3, point: DVec3, normal: DVec3) -> f64 {
     let to_surface = point - reference;
     let distance_squared = to_surface.length_squared();
-    let cos_surface = normal.dot(to_surface.normalize()).abs();
-    if cos_surface == 0.0 {
+    // As in `by_area`: d³/(|n·(p − x)| A).
+    let projected = normal.dot(to_surface).abs();
+    if projected == 0.0 {
         return 0.0;
     }
-    distance_squared / (cos_surface * area)
+    distance_squared * distance_squared.sqrt() / (projected * area)
 }
