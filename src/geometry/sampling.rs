@@ -27,8 +27,11 @@ pub fn by_area(sample: AreaSample, area: f64, reference: DVec3) -> Option<ShapeS
     let to_surface = sample.point - reference;
     let distance_squared = to_surface.length_squared();
     let distance = distance_squared.sqrt();
-    // d²/(|cos θ| A) with |cos θ| = |n·(p − x)|/d: d³/(|n·(p − x)| A), one
-    // division after the square root instead of three.
+    // d²/(|cos θ| A) with |cos θ| = |n·(p − x)|/d is d³/(|n·(p − x)| A):
+    // after the square root, a product and one division, where the cosine
+    // of the normalised direction took a reciprocal, a product and a dot
+    // product before the density's division. (Coordinates are at most 10¹²,
+    // so d³ stays far inside the range of f64.)
     let projected = sample.normal.dot(to_surface).abs();
     if projected == 0.0 || distance_squared == 0.0 {
         return None;
