@@ -416,6 +416,16 @@ impl Scene {
         self.intersect_skipping::<true>(ray, t_max, leaving.shape_index())
     }
 
+    /// [`Scene::intersect_leaving`] compiled into its caller. The hit record
+    /// then reaches the caller's code without a return through memory. That
+    /// pays in a path tracer whose loop is small (scenes without specular
+    /// balls), not in the larger loop with the balls' connections
+    /// (docs/performance.md, "The traversal inlined into the path loop").
+    #[inline(always)]
+    pub fn intersect_leaving_inlined(&self, ray: &Ray, t_max: f64, leaving: Leaving) -> Option<Intersection> {
+        self.intersect_skipping::<true>(ray, t_max, leaving.shape_index())
+    }
+
     /// The nearest hit, skipping shape `skipped` when `SKIP` (compiled
     /// twice, so rays that skip nothing pay no comparison per shape).
     #[inline(always)]

@@ -162,7 +162,11 @@ impl PathTracer {
 
         for bounce in 0.. {
             let draws = BounceDraws::new(sampler, light_sampling, scene.lights.len() > 1);
-            let Some(intersection) = scene.intersect_leaving(&ray, f64::INFINITY, leaving) else {
+            let found = match balls {
+                true => scene.intersect_leaving(&ray, f64::INFINITY, leaving),
+                false => scene.intersect_leaving_inlined(&ray, f64::INFINITY, leaving),
+            };
+            let Some(intersection) = found else {
                 radiance += throughput * C::from_rgb(scene.background, wavelengths);
                 break;
             };
