@@ -14,6 +14,11 @@
 //! the bunny meshes (3.7k, 59k, 941k triangles) rays ran 4–19% faster than
 //! with four-wide nodes; the shipped scenes ran level (docs/performance.md).
 //!
+//! The traversal is compiled twice, for baseline x86-64 and for AVX2,
+//! whose node test takes the eight children in one eight-lane operation
+//! where baseline x86-64 takes two four-lane halves; the copy a CPU runs is
+//! chosen when the tree is built ([`super::kernel`]).
+//!
 //! Traversal is front to back: the children a ray enters are visited
 //! nearest first, and a subtree whose entry distance lies beyond the
 //! nearest hit so far is skipped. The box test is conservative (see
@@ -21,12 +26,13 @@
 //! primitive test would hit.
 //!
 //! The BVH knows only boxes and leaves: what a leaf's primitives are, and
-//! how to hit them, is the caller's closure. Leaves hold primitives of one
+//! how to hit them, is the caller's [`LeafVisitor`]. Leaves hold primitives of one
 //! kind (the scene's: triangles, spheres, other shapes), numbered within that kind.
 
 use super::bounds::{Bounds32, round_up, sign_mask32};
 use super::build::{self, BinaryContent, BinaryNode, Box4, BuildItem, LeafKind, MAX_LEAF_SIZE};
 use super::collapse::Collapse;
+use super::kernel::{Avx2, Kernel};
 use crate::math::lane_mask::set_lanes;
 use crate::math::{Aabb, Ray};
 use arrayvec::ArrayVec;
@@ -121,6 +127,69 @@ impl Leaf {
     }
 }
 
+/// What a traversal does at the leaves it reaches. Its methods are
+/// compiled into the traversal (mark them `#[inline(always)]`): the
+/// traversal is compiled once per [`Kernel`], and a leaf test reached from
+/// two copies would otherwise stay an out-of-line call per leaf.
+pub trait LeafVisitor {
+    /// Tests `leaf`'s primitives, lowers `*t_max` to the nearest hit it
+    /// finds, and returns true to end the traversal.
+    fn visit(&mut self, leaf: Leaf, t_max: &mut f64) -> bool;
+
+    /// Starts loading the primitives of `leaf`, which the traversal has
+    /// deferred (called only in trees larger than the caches).
+    fn prefetch(&self, _leaf: Leaf) {}
+}
+
+/// How a caller's nearest-hit queries reach the traversal: [`Dispatched`]
+/// through the tree's own choice of kernel, or, for a caller compiled for
+/// AVX2 ([`Avx2::run`]), [`Avx2`], the AVX2 traversal compiled into it.
+pub trait Traversal: Copy {
+    /// [`Bvh::traverse_nearest`], by this route.
+    fn nearest(self, bvh: &Bvh, ray: &Ray, t_max: &mut f64, visitor: &mut impl LeafVisitor);
+}
+
+/// The tree's own choice of kernel, made per query ([`Bvh::traverse_nearest`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Dispatched;
+
+impl Traversal for Dispatched {
+    #[inline(always)]
+    fn nearest(self, bvh: &Bvh, ray: &Ray, t_max: &mut f64, visitor: &mut impl LeafVisitor) {
+        bvh.traverse_nearest(ray, t_max, visitor);
+    }
+}
+
+/// The baseline kernel compiled into the caller, whatever the tree's choice.
+#[derive(Clone, Copy, Debug)]
+pub struct Portable;
+
+impl Traversal for Portable {
+    #[inline(always)]
+    fn nearest(self, bvh: &Bvh, ray: &Ray, t_max: &mut f64, visitor: &mut impl LeafVisitor) {
+        bvh.traverse_compiled::<true, false>(ray, t_max, visitor);
+    }
+}
+
+/// The AVX2 kernel compiled into the caller, which should itself be
+/// compiled for AVX2 (run inside [`Avx2::run`]).
+impl Traversal for Avx2 {
+    #[inline(always)]
+    fn nearest(self, bvh: &Bvh, ray: &Ray, t_max: &mut f64, visitor: &mut impl LeafVisitor) {
+        bvh.traverse_compiled::<true, true>(ray, t_max, visitor);
+    }
+}
+
+/// A closure as a [`LeafVisitor`] that prefetches nothing.
+struct VisitFn<F>(F);
+
+impl<F: FnMut(Leaf, &mut f64) -> bool> LeafVisitor for VisitFn<F> {
+    #[inline(always)]
+    fn visit(&mut self, leaf: Leaf, t_max: &mut f64) -> bool {
+        (self.0)(leaf, t_max)
+    }
+}
+
 /// A primitive to build over: its exact bounds and its kind.
 #[derive(Clone, Copy, Debug)]
 pub struct BuildPrimitive {
@@ -142,6 +211,8 @@ pub struct Bvh {
     /// Whether the nodes outgrow the caches near a core, so that the
     /// traversal prefetches the children it defers.
     prefetches: bool,
+    /// Present when traversals run compiled for AVX2 (see [`Kernel`]).
+    avx2: Option<Avx2>,
 }
 
 /// Node bytes above which the traversal prefetches the children it defers.
@@ -207,9 +278,33 @@ impl Bvh {
                 leaf_count: collapser.leaf_count,
                 depth: collapser.depth,
                 prefetches,
+                avx2: Avx2::detect(),
             },
             orders,
         )
+    }
+
+    /// The proof of AVX2 when traversals run compiled for it, for callers
+    /// that compile their own loops to match ([`Avx2::run`]).
+    pub fn avx2(&self) -> Option<Avx2> {
+        self.avx2
+    }
+
+    /// The kernel traversals run with.
+    pub fn kernel(&self) -> Kernel {
+        match self.avx2 {
+            Some(_) => Kernel::Avx2,
+            None => Kernel::Portable,
+        }
+    }
+
+    /// Runs traversals with `kernel`, if this CPU has it (else the portable
+    /// one): to compare the kernels. Builds choose [`Kernel::chosen`].
+    pub fn set_kernel(&mut self, kernel: Kernel) {
+        self.avx2 = match kernel {
+            Kernel::Avx2 => Avx2::detect(),
+            Kernel::Portable => None,
+        };
     }
 
     /// Number of eight-wide nodes (interior nodes only; leaves are references).
@@ -257,47 +352,48 @@ impl Bvh {
     /// nearest hit it finds, and returns true to end the traversal.
     #[inline]
     pub fn traverse(&self, ray: &Ray, t_max: &mut f64, visit: impl FnMut(Leaf, &mut f64) -> bool) {
-        self.traverse_sized::<true>(ray, t_max, visit, |_| ());
+        self.traverse_nearest(ray, t_max, &mut VisitFn(visit));
     }
 
-    /// [`Bvh::traverse`] that also calls `prefetch_leaf` for each leaf it
-    /// defers (in a tree larger than the caches), so the caller can start
-    /// loading that leaf's primitives.
-    #[inline]
-    pub fn traverse_prefetching(
-        &self,
-        ray: &Ray,
-        t_max: &mut f64,
-        visit: impl FnMut(Leaf, &mut f64) -> bool,
-        prefetch_leaf: impl Fn(Leaf),
-    ) {
-        self.traverse_sized::<true>(ray, t_max, visit, prefetch_leaf);
+    /// Visits the leaves `ray` enters, nearest first, as [`Bvh::traverse`]
+    /// does, with `visitor`'s test (always compiled into the traversal);
+    /// in a tree larger than the caches, calls [`LeafVisitor::prefetch`]
+    /// for each leaf it defers.
+    #[inline(always)]
+    pub fn traverse_nearest(&self, ray: &Ray, t_max: &mut f64, visitor: &mut impl LeafVisitor) {
+        self.traverse_sized::<true>(ray, t_max, visitor);
     }
 
     /// Visits the leaves `ray` enters in any order (no sorting) until
-    /// `visit` returns true: for any-hit (occlusion) queries. Prefetches
-    /// as [`Bvh::traverse_prefetching`] does.
-    #[inline]
-    pub fn traverse_unordered(
-        &self,
-        ray: &Ray,
-        t_max: &mut f64,
-        visit: impl FnMut(Leaf, &mut f64) -> bool,
-        prefetch_leaf: impl Fn(Leaf),
-    ) {
-        self.traverse_sized::<false>(ray, t_max, visit, prefetch_leaf);
+    /// `visitor` returns true: for any-hit (occlusion) queries. Prefetches
+    /// as [`Bvh::traverse_nearest`] does.
+    #[inline(always)]
+    pub fn traverse_any(&self, ray: &Ray, t_max: &mut f64, visitor: &mut impl LeafVisitor) {
+        self.traverse_sized::<false>(ray, t_max, visitor);
     }
 
-    /// One traversal loop for every tree: with a single copy of the loop
-    /// the leaf visitor has one call site, so the compiler inlines it (two
-    /// copies, one per stack type, left it an out-of-line call per leaf).
+    /// The traversal, with the kernel this tree runs (see [`Kernel`]):
+    /// compiled for AVX2 where the CPU has it, with the leaf tests inside.
     #[inline(always)]
-    fn traverse_sized<const NEAREST_FIRST: bool>(
+    fn traverse_sized<const NEAREST_FIRST: bool>(&self, ray: &Ray, t_max: &mut f64, visitor: &mut impl LeafVisitor) {
+        match self.avx2 {
+            Some(avx2) => avx2.run(
+                #[inline(always)]
+                || self.traverse_compiled::<NEAREST_FIRST, true>(ray, t_max, visitor),
+            ),
+            None => self.traverse_compiled::<NEAREST_FIRST, false>(ray, t_max, visitor),
+        }
+    }
+
+    /// The traversal, compiled into whichever function calls it. `AVX2`:
+    /// with AVX2's node test, which only code reached through an [`Avx2`]
+    /// (the proof that the CPU has it) may ask for.
+    #[inline(always)]
+    fn traverse_compiled<const NEAREST_FIRST: bool, const AVX2: bool>(
         &self,
         ray: &Ray,
         t_max: &mut f64,
-        visit: impl FnMut(Leaf, &mut f64) -> bool,
-        prefetch_leaf: impl Fn(Leaf),
+        visitor: &mut impl LeafVisitor,
     ) {
         if self.nodes.is_empty() {
             return;
@@ -305,29 +401,28 @@ impl Bvh {
         // Prepared here, in this frame, so the 432-byte record is never copied.
         let ray = &TraversalRay::new(ray);
         let mut stack = TraversalStack::new();
-        self.traverse_with::<NEAREST_FIRST>(&mut stack, ray, t_max, visit, prefetch_leaf);
+        self.traverse_with::<NEAREST_FIRST, AVX2>(&mut stack, ray, t_max, visitor);
     }
 
     #[inline(always)]
-    fn traverse_with<const NEAREST_FIRST: bool>(
+    fn traverse_with<const NEAREST_FIRST: bool, const AVX2: bool>(
         &self,
         stack: &mut TraversalStack,
         ray: &TraversalRay,
         t_max: &mut f64,
-        mut visit: impl FnMut(Leaf, &mut f64) -> bool,
-        prefetch_leaf: impl Fn(Leaf),
+        visitor: &mut impl LeafVisitor,
     ) {
         // Defers a child, first starting its load when the tree is larger
         // than the caches: its miss then overlaps the traversal of the
         // subtree visited first, instead of stalling the step that pops it.
         let prefetches = self.prefetches;
-        let defer = |stack: &mut TraversalStack, entry: u64| {
+        let defer = |stack: &mut TraversalStack, visitor: &mut _, entry: u64| {
             if prefetches {
                 let child = entry as u32;
                 if child & LEAF_BIT == 0 {
                     self.prefetch_node(child);
                 } else {
-                    prefetch_leaf(Leaf::from_reference(child));
+                    LeafVisitor::prefetch(visitor, Leaf::from_reference(child));
                 }
             }
             stack.push(entry);
@@ -338,7 +433,7 @@ impl Bvh {
         loop {
             if current & LEAF_BIT == 0 {
                 let node = &self.nodes[current as usize];
-                let (t_near, hit) = ray.enter_children(node, limit);
+                let (t_near, hit) = ray.enter(node, limit, AVX2);
                 // Whether the ray enters none, one or several children is a
                 // branch that often mispredicts, so it is decided by bit
                 // tests that resolve at once, and the entered children are
@@ -372,7 +467,7 @@ impl Bvh {
                     }
                     // Leave the farther ones for later, farthest deepest; go on with the nearest.
                     for &key in keys[1..entered.min(WIDTH)].iter().rev() {
-                        defer(stack, key);
+                        defer(stack, &mut *visitor, key);
                     }
                     current = keys[0] as u32;
                     continue;
@@ -381,12 +476,12 @@ impl Bvh {
                     let mut lanes = set_lanes(hit);
                     current = node.children[lanes.next().unwrap_or_default()];
                     for lane in lanes {
-                        defer(stack, pack(node.children[lane], t_near[lane]));
+                        defer(stack, &mut *visitor, pack(node.children[lane], t_near[lane]));
                     }
                     continue;
                 }
             } else {
-                if visit(Leaf::from_reference(current), t_max) {
+                if visitor.visit(Leaf::from_reference(current), t_max) {
                     return;
                 }
                 limit = traversal_limit(*t_max);
@@ -571,6 +666,22 @@ impl TraversalRay {
         }
     }
 
+    /// [`TraversalRay::enter_children`], in AVX2 instructions when `avx2`
+    /// (a constant: the traversal is compiled once with each, and the
+    /// AVX2 copy is reached only through functions that take an [`Avx2`],
+    /// the proof that the CPU has it).
+    #[inline(always)]
+    fn enter(&self, node: &Node, t_max: f32, avx2: bool) -> ([f32; WIDTH], u32) {
+        #[cfg(target_arch = "x86_64")]
+        if avx2 {
+            // SAFETY: see above: this CPU has AVX2.
+            #[allow(unsafe_code)]
+            return unsafe { self.enter_children_avx2(node, t_max) };
+        }
+        let _ = avx2;
+        self.enter_children(node, t_max)
+    }
+
     /// Entry distances of the eight children and a bit mask (bit i for
     /// lane i) of those the ray enters before `t_max`.
     #[inline(always)]
@@ -585,6 +696,39 @@ impl TraversalRay {
             t_exit = exit.fast_min(t_exit);
         }
         (t_entry.to_array(), t_entry.cmp_le(t_exit).move_mask() as u32)
+    }
+
+    /// [`TraversalRay::enter_children`] in eight-lane AVX instructions
+    /// (`wide`'s eight lanes are two four-lane halves unless the whole
+    /// program is compiled for AVX): the same operations, operands and
+    /// order, so the same answers bit for bit.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn enter_children_avx2(&self, node: &Node, t_max: f32) -> ([f32; WIDTH], u32) {
+        use std::arch::x86_64::{
+            __m256, _CMP_LE_OQ, _mm256_cmp_ps, _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_set1_ps,
+            _mm256_setzero_ps, _mm256_sub_ps,
+        };
+        let lanes = |values: &[f32; WIDTH]| bytemuck::cast::<[f32; WIDTH], __m256>(*values);
+        let splat = |value: f32x8| bytemuck::cast::<f32x8, __m256>(value);
+        let mut t_entry = _mm256_setzero_ps();
+        let mut t_exit = _mm256_set1_ps(t_max);
+        for axis in 0..3 {
+            let entry = _mm256_mul_ps(
+                _mm256_sub_ps(lanes(&node.bounds[self.entry_plane[axis]]), splat(self.entry_origin[axis])),
+                splat(self.reciprocal[axis]),
+            );
+            let exit = _mm256_mul_ps(
+                _mm256_sub_ps(lanes(&node.bounds[self.exit_plane[axis]]), splat(self.exit_origin[axis])),
+                splat(self.exit_reciprocal[axis]),
+            );
+            // As `maxps`/`minps` above: the second operand when the first is NaN.
+            t_entry = _mm256_max_ps(entry, t_entry);
+            t_exit = _mm256_min_ps(exit, t_exit);
+        }
+        let entered = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t_entry, t_exit)) as u32;
+        (bytemuck::cast(t_entry), entered)
     }
 }
 
@@ -678,6 +822,22 @@ mod tests {
     /// the traversal visits the same leaves and gives the same answers:
     /// the nearest hit equals brute force's, occlusion agrees, and leaves
     /// were indeed prefetched.
+    /// A visitor that counts the leaves prefetched.
+    struct Counting<'a, F> {
+        visit: F,
+        prefetched: &'a std::cell::Cell<usize>,
+    }
+
+    impl<F: FnMut(Leaf, &mut f64) -> bool> LeafVisitor for Counting<'_, F> {
+        fn visit(&mut self, leaf: Leaf, t_max: &mut f64) -> bool {
+            (self.visit)(leaf, t_max)
+        }
+
+        fn prefetch(&self, _leaf: Leaf) {
+            self.prefetched.set(self.prefetched.get() + 1);
+        }
+    }
+
     #[test]
     fn prefetching_changes_no_answer() {
         let boxes = random_boxes(3000, 777);
@@ -699,33 +859,102 @@ mod tests {
                 .filter_map(|b| b.hit_distance(ray.origin, inverse, f64::INFINITY))
                 .fold(f64::INFINITY, f64::min);
             let mut nearest = f64::INFINITY;
-            let count = |_: Leaf| prefetched.set(prefetched.get() + 1);
-            bvh.traverse_prefetching(
+            bvh.traverse_nearest(
                 &ray,
                 &mut nearest,
-                |leaf, t_max| {
-                    if let Some(t) = hit(leaf, *t_max) {
-                        *t_max = t;
-                    }
-                    false
+                &mut Counting {
+                    visit: |leaf: Leaf, t_max: &mut f64| {
+                        if let Some(t) = hit(leaf, *t_max) {
+                            *t_max = t;
+                        }
+                        false
+                    },
+                    prefetched: &prefetched,
                 },
-                count,
             );
             assert_eq!(nearest, brute);
             let mut any = f64::INFINITY;
             let mut occluded = false;
-            bvh.traverse_unordered(
+            bvh.traverse_any(
                 &ray,
                 &mut any,
-                |leaf, t_max| {
-                    occluded = hit(leaf, *t_max).is_some();
-                    occluded
+                &mut Counting {
+                    visit: |leaf: Leaf, t_max: &mut f64| {
+                        occluded = hit(leaf, *t_max).is_some();
+                        occluded
+                    },
+                    prefetched: &prefetched,
                 },
-                count,
             );
             assert_eq!(occluded, brute.is_finite());
         }
         assert!(prefetched.get() > 0);
+    }
+
+    /// Both kernels visit the same leaves in the same order with the same
+    /// bounds, so every answer is the same bit for bit: random boxes, rays
+    /// from all around (among them axis-parallel ones, whose zero direction
+    /// components give infinite reciprocals), nearest-first and any-order.
+    #[test]
+    fn kernels_visit_the_same_leaves() {
+        if !Kernel::Avx2.available() {
+            eprintln!("this CPU has no AVX2: only the portable kernel runs here");
+            return;
+        }
+        let boxes = random_boxes(3000, 99);
+        let primitives: Vec<BuildPrimitive> = boxes.iter().map(|b| BuildPrimitive { bounds: *b, kind: 0 }).collect();
+        let (mut bvh, orders) = Bvh::build(&primitives);
+        let mut rays: Vec<Ray> = random_boxes(1500, 5)
+            .iter()
+            .map(|b| Ray::new(b.min * 1.3 - DVec3::splat(20.0), b.max - DVec3::splat(40.0)))
+            .collect();
+        for axis in [DVec3::X, DVec3::NEG_Y, DVec3::Z] {
+            rays.push(Ray::new(DVec3::splat(-60.0) + axis * 10.0, axis));
+            rays.push(Ray::new(boxes[0].min, axis));
+        }
+        // Per ray: the leaves visited with the bound each was met with, and
+        // the final distance, for the nearest-hit and the any-hit traversal.
+        type Visits = (Vec<(Leaf, u64)>, u64, Vec<Leaf>);
+        let trace = |bvh: &Bvh| -> Vec<Visits> {
+            rays.iter()
+                .map(|ray| {
+                    let inverse = DVec3::ONE / ray.direction;
+                    let mut visited = Vec::new();
+                    let mut t = f64::INFINITY;
+                    bvh.traverse(ray, &mut t, |leaf, t_max| {
+                        visited.push((leaf, t_max.to_bits()));
+                        for i in leaf.first..leaf.first + leaf.count {
+                            let original = orders[0][i as usize] as usize;
+                            if let Some(hit) = boxes[original].hit_distance(ray.origin, inverse, *t_max) {
+                                *t_max = hit;
+                            }
+                        }
+                        false
+                    });
+                    let mut any = Vec::new();
+                    bvh.traverse_any(
+                        ray,
+                        &mut f64::INFINITY.clone(),
+                        &mut VisitFn(|leaf: Leaf, _: &mut f64| {
+                            any.push(leaf);
+                            false
+                        }),
+                    );
+                    (visited, t.to_bits(), any)
+                })
+                .collect()
+        };
+        bvh.set_kernel(Kernel::Avx2);
+        assert_eq!(bvh.kernel(), Kernel::Avx2);
+        let avx2 = trace(&bvh);
+        bvh.set_kernel(Kernel::Portable);
+        assert_eq!(bvh.kernel(), Kernel::Portable);
+        let portable = trace(&bvh);
+        assert!(
+            avx2.iter()
+                .any(|(visited, t, _)| visited.len() > 1 && f64::from_bits(*t).is_finite())
+        );
+        assert_eq!(avx2, portable);
     }
 
     /// The nearest box hit along `ray`, by testing every box and through the BVH.

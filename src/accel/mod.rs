@@ -1,16 +1,19 @@
 //! Acceleration structures. The BVH knows only bounding boxes and leaf
 //! ranges; what a leaf's primitives are, and how to hit them, is the
-//! caller's closure.
+//! caller's [`LeafVisitor`].
 //!
 //! - [`build`]: the binned-SAH binary tree builder;
 //! - [`collapse`]: which binary nodes become eight-wide nodes;
 //! - [`bvh`]: the eight-wide tree collapsed from it, and its traversal;
-//! - [`bounds`]: the outward-rounded single-precision boxes both use.
+//! - [`bounds`]: the outward-rounded single-precision boxes both use;
+//! - [`kernel`]: which instructions the queries run with, chosen at run time.
 
 pub mod bounds;
 pub mod build;
 pub mod bvh;
 pub mod collapse;
+pub mod kernel;
 
 pub use build::LeafKind;
-pub use bvh::{BuildPrimitive, Bvh, Leaf, TraversalRay};
+pub use bvh::{BuildPrimitive, Bvh, Dispatched, Leaf, LeafVisitor, Portable, Traversal, TraversalRay};
+pub use kernel::{Avx2, Kernel};

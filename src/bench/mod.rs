@@ -80,8 +80,10 @@ pub fn machine_note() -> String {
 
 /// How this binary was compiled: the same code runs faster when built for
 /// a newer instruction set or with a profile (docs/performance.md,
-/// "Profile-guided and host-tuned builds"). `benches/pgo/build.sh` sets
-/// `PRISM_PGO` while it compiles the profile-guided binary.
+/// "Profile-guided and host-tuned builds"), and which kernel the ray
+/// queries chose at run time ([`crate::accel::kernel`]).
+/// `benches/pgo/build.sh` sets `PRISM_PGO` while it compiles the
+/// profile-guided binary.
 pub fn build_note() -> String {
     let kind = if cfg!(debug_assertions) { "debug" } else { "release" };
     let instruction_set = if cfg!(target_feature = "avx512f") {
@@ -98,7 +100,11 @@ pub fn build_note() -> String {
     } else {
         ""
     };
-    format!("{kind} build for {instruction_set}{profile}")
+    let queries = match crate::accel::Kernel::chosen() {
+        crate::accel::Kernel::Avx2 => "; ray queries and path loop run compiled for AVX2 (chosen at run time)",
+        crate::accel::Kernel::Portable => "",
+    };
+    format!("{kind} build for {instruction_set}{profile}{queries}")
 }
 
 /// A CSV table: `#` comment lines, a header, rows; written atomically.

@@ -333,7 +333,7 @@ impl Drop for RenderSession {
 /// rendering, an interactive thread (the UI) still gets a core when it wakes:
 /// CFS weighs nice 10 at about a tenth of nice 0. Linux only, and best effort:
 /// `setpriority` on a thread id affects that thread alone, and `renice` is
-/// used because this crate has no `unsafe` to call it directly.
+/// used because this crate keeps `unsafe` to its AVX2 kernels alone.
 fn lower_thread_priority(niceness: u8) {
     if niceness == 0 || !cfg!(target_os = "linux") {
         return;

@@ -19,7 +19,7 @@ pub use progress::{LoadStage, load_scene_file_with_progress};
 pub use similarity::{Similarity, load_scene_str_placed};
 pub use specular_balls::{MAX_SPECULAR_BALLS, SpecularBall};
 
-use crate::accel::{BuildPrimitive, Bvh, Leaf, LeafKind};
+use crate::accel::{BuildPrimitive, Bvh, Dispatched, Kernel, Leaf, LeafKind, LeafVisitor, Traversal};
 use crate::color::Color;
 use crate::geometry::clipped_sphere::clip_emitters;
 use crate::geometry::spheres::Spheres;
@@ -406,14 +406,14 @@ impl Scene {
     /// once, for the final hit, from those results.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<Intersection> {
-        self.intersect_skipping::<false>(ray, t_max, u32::MAX)
+        self.intersect_skipping::<false>(Dispatched, ray, t_max, u32::MAX)
     }
 
     /// [`Scene::intersect`] for a ray spawned on a surface, which skips
     /// what [`Scene::leaving`] says it cannot hit again.
     #[inline]
     pub fn intersect_leaving(&self, ray: &Ray, t_max: f64, leaving: Leaving) -> Option<Intersection> {
-        self.intersect_skipping::<true>(ray, t_max, leaving.shape_index())
+        self.intersect_skipping::<true>(Dispatched, ray, t_max, leaving.shape_index())
     }
 
     /// [`Scene::intersect_leaving`] compiled into its caller. The hit record
@@ -421,66 +421,39 @@ impl Scene {
     /// pays in a path tracer whose loop is small (scenes without specular
     /// balls), not in the larger loop with the balls' connections
     /// (docs/performance.md, "The traversal inlined into the path loop").
+    /// `traversal`: [`crate::accel::Portable`], or [`crate::accel::Avx2`] in
+    /// a loop compiled for AVX2 ([`crate::accel::Avx2::run`]).
     #[inline(always)]
-    pub fn intersect_leaving_inlined(&self, ray: &Ray, t_max: f64, leaving: Leaving) -> Option<Intersection> {
-        self.intersect_skipping::<true>(ray, t_max, leaving.shape_index())
+    pub fn intersect_leaving_inlined(
+        &self,
+        traversal: impl Traversal,
+        ray: &Ray,
+        t_max: f64,
+        leaving: Leaving,
+    ) -> Option<Intersection> {
+        self.intersect_skipping::<true>(traversal, ray, t_max, leaving.shape_index())
     }
 
     /// The nearest hit, skipping shape `skipped` when `SKIP` (compiled
     /// twice, so rays that skip nothing pay no comparison per shape).
     #[inline(always)]
-    fn intersect_skipping<const SKIP: bool>(&self, ray: &Ray, t_max: f64, skipped: u32) -> Option<Intersection> {
-        /// The nearest hit so far. Candidates are compared by distance
-        /// alone; the hit record (normal, uv, error bounds) is built once,
-        /// for the nearest, except for surfaces of revolution, whose root
-        /// finding depends on the bound and so keeps the record it found.
-        enum Nearest {
-            Nothing,
-            Triangle(LeafHit),
-            Shape(u32, ShapeHit),
-            Record(Intersection),
-        }
-        // The triangle test's per-ray constants, made when a triangle leaf is first reached.
-        let mut triangle_ray: Option<TriangleRay> = None;
-        let mut nearest = Nearest::Nothing;
-        let mut t = t_max;
-        self.bvh.traverse_prefetching(
+    fn intersect_skipping<const SKIP: bool>(
+        &self,
+        traversal: impl Traversal,
+        ray: &Ray,
+        t_max: f64,
+        skipped: u32,
+    ) -> Option<Intersection> {
+        let mut visitor = NearestVisitor::<SKIP> {
+            scene: self,
             ray,
-            &mut t,
-            |leaf, t_max| {
-                if leaf.kind == TRIANGLE_LEAF {
-                    let triangle_ray = triangle_ray.get_or_insert_with(|| TriangleRay::new(ray));
-                    if let Some(found) = self.triangles.intersect_leaf(triangle_ray, leaf.first, leaf.count, *t_max) {
-                        *t_max = found.hit.t;
-                        nearest = Nearest::Triangle(found);
-                    }
-                } else if leaf.kind == SPHERE_LEAF {
-                    if let Some(found) = self.spheres.intersect_leaf(ray, leaf.first, leaf.count, *t_max) {
-                        *t_max = found.t;
-                        nearest = Nearest::Shape(self.first_sphere + found.index, ShapeHit::Sphere(found.t));
-                    }
-                } else {
-                    for index in leaf.first..leaf.first + leaf.count {
-                        if SKIP && index == skipped {
-                            continue;
-                        }
-                        let shape = &self.shapes[index as usize].shape;
-                        if let Shape::Revolution(revolution) = shape {
-                            if let Some(hit) = revolution.intersect(ray, *t_max) {
-                                *t_max = hit.t;
-                                nearest = Nearest::Record(Intersection { hit, primitive: index });
-                            }
-                        } else if let Some(hit) = shape.nearest_hit(ray, *t_max) {
-                            *t_max = hit.t();
-                            nearest = Nearest::Shape(index, hit);
-                        }
-                    }
-                }
-                false
-            },
-            |leaf| self.prefetch_leaf(leaf),
-        );
-        match nearest {
+            skipped,
+            triangle_ray: None,
+            nearest: Nearest::Nothing,
+        };
+        let mut t = t_max;
+        traversal.nearest(&self.bvh, ray, &mut t, &mut visitor);
+        match visitor.nearest {
             Nearest::Nothing => None,
             Nearest::Triangle(found) => {
                 let triangle = self.triangles.get(found.index);
@@ -521,29 +494,16 @@ impl Scene {
     /// lies on the ray before `t_max`.
     #[inline(always)]
     fn occluded_skipping<const SKIP: bool>(&self, ray: &Ray, t_max: f64, skipped: u32, target: u32) -> bool {
-        let mut triangle_ray: Option<TriangleRay> = None;
-        let mut t = t_max;
-        let mut found = false;
-        self.bvh.traverse_unordered(
+        let mut visitor = OcclusionVisitor::<SKIP> {
+            scene: self,
             ray,
-            &mut t,
-            |leaf, t_max| {
-                found = if leaf.kind == TRIANGLE_LEAF {
-                    let triangle_ray = triangle_ray.get_or_insert_with(|| TriangleRay::new(ray));
-                    self.triangles.occludes_leaf(triangle_ray, leaf.first, leaf.count, *t_max)
-                } else if leaf.kind == SPHERE_LEAF {
-                    self.spheres.occludes_leaf(ray, leaf.first, leaf.count, *t_max)
-                } else {
-                    (leaf.first..leaf.first + leaf.count).any(|index| {
-                        !(SKIP && (index == skipped || index == target))
-                            && self.shapes[index as usize].shape.hit_distance(ray, *t_max).is_some()
-                    })
-                };
-                found
-            },
-            |leaf| self.prefetch_leaf(leaf),
-        );
-        found
+            skipped: (skipped, target),
+            triangle_ray: None,
+            found: false,
+        };
+        let mut t = t_max;
+        self.bvh.traverse_any(ray, &mut t, &mut visitor);
+        visitor.found
     }
 
     /// Starts loading the primitives of a leaf the traversal deferred (in
@@ -561,6 +521,13 @@ impl Scene {
         &self.bvh
     }
 
+    /// Runs this scene's ray queries (and the path tracer's loop, which
+    /// follows the BVH's choice) with `kernel` where the CPU has it: to
+    /// compare the kernels, which must give the same answers.
+    pub fn set_kernel(&mut self, kernel: Kernel) {
+        self.bvh.set_kernel(kernel);
+    }
+
     /// Bytes of the BVH nodes plus the triangles' leaf data.
     pub fn acceleration_bytes(&self) -> usize {
         self.bvh.memory_bytes() + self.triangles.len() * Triangles::BYTES_PER_TRIANGLE
@@ -573,6 +540,118 @@ impl EmitterSource for Scene {
             Some(triangle) => Emitter::Triangle(self.triangles.get(triangle)),
             None => Emitter::Shape(&self.shapes[primitive as usize].shape),
         }
+    }
+}
+
+/// The nearest hit so far. Candidates are compared by distance
+/// alone; the hit record (normal, uv, error bounds) is built once,
+/// for the nearest, except for surfaces of revolution, whose root
+/// finding depends on the bound and so keeps the record it found.
+enum Nearest {
+    Nothing,
+    Triangle(LeafHit),
+    Shape(u32, ShapeHit),
+    Record(Intersection),
+}
+
+/// The nearest-hit query's leaf test: lowers `t_max` and records each
+/// nearer hit; shape `skipped` is passed over when `SKIP`.
+struct NearestVisitor<'a, const SKIP: bool> {
+    scene: &'a Scene,
+    ray: &'a Ray,
+    skipped: u32,
+    /// The triangle test's per-ray constants, made when a triangle leaf is first reached.
+    triangle_ray: Option<TriangleRay>,
+    nearest: Nearest,
+}
+
+impl<const SKIP: bool> LeafVisitor for NearestVisitor<'_, SKIP> {
+    #[inline(always)]
+    fn visit(&mut self, leaf: Leaf, t_max: &mut f64) -> bool {
+        if leaf.kind == TRIANGLE_LEAF {
+            let triangle_ray = self.triangle_ray.get_or_insert_with(|| TriangleRay::new(self.ray));
+            if let Some(found) = self
+                .scene
+                .triangles
+                .intersect_leaf(triangle_ray, leaf.first, leaf.count, *t_max)
+            {
+                *t_max = found.hit.t;
+                self.nearest = Nearest::Triangle(found);
+            }
+        } else if leaf.kind == SPHERE_LEAF {
+            if let Some(found) = self.scene.spheres.intersect_leaf(self.ray, leaf.first, leaf.count, *t_max) {
+                *t_max = found.t;
+                self.nearest = Nearest::Shape(self.scene.first_sphere + found.index, ShapeHit::Sphere(found.t));
+            }
+        } else {
+            for index in leaf.first..leaf.first + leaf.count {
+                if SKIP && index == self.skipped {
+                    continue;
+                }
+                let shape = &self.scene.shapes[index as usize].shape;
+                if let Shape::Revolution(revolution) = shape {
+                    if let Some(hit) = revolution.intersect(self.ray, *t_max) {
+                        *t_max = hit.t;
+                        self.nearest = Nearest::Record(Intersection { hit, primitive: index });
+                    }
+                } else if let Some(hit) = shape.nearest_hit(self.ray, *t_max) {
+                    *t_max = hit.t();
+                    self.nearest = Nearest::Shape(index, hit);
+                }
+            }
+        }
+        false
+    }
+
+    #[inline(always)]
+    fn prefetch(&self, leaf: Leaf) {
+        self.scene.prefetch_leaf(leaf);
+    }
+}
+
+/// The any-hit query's leaf test: whether anything in a leaf but shapes
+/// `skipped` (when `SKIP`) lies on the ray before `t_max`.
+struct OcclusionVisitor<'a, const SKIP: bool> {
+    scene: &'a Scene,
+    ray: &'a Ray,
+    skipped: (u32, u32),
+    triangle_ray: Option<TriangleRay>,
+    found: bool,
+}
+
+impl<const SKIP: bool> LeafVisitor for OcclusionVisitor<'_, SKIP> {
+    #[inline(always)]
+    fn visit(&mut self, leaf: Leaf, t_max: &mut f64) -> bool {
+        self.found = {
+            if leaf.kind == TRIANGLE_LEAF {
+                let triangle_ray = self.triangle_ray.get_or_insert_with(|| TriangleRay::new(self.ray));
+                self.scene
+                    .triangles
+                    .occludes_leaf(triangle_ray, leaf.first, leaf.count, *t_max)
+            } else if leaf.kind == SPHERE_LEAF {
+                self.scene.spheres.occludes_leaf(self.ray, leaf.first, leaf.count, *t_max)
+            } else {
+                let mut found = false;
+                for index in leaf.first..leaf.first + leaf.count {
+                    if !(SKIP && (index == self.skipped.0 || index == self.skipped.1))
+                        && self.scene.shapes[index as usize]
+                            .shape
+                            .hit_distance(self.ray, *t_max)
+                            .is_some()
+                    {
+                        found = true;
+                        break;
+                    }
+                }
+                found
+            }
+        };
+        self.found
+    }
+
+    #[inline(always)]
+    fn prefetch(&self, leaf: Leaf) {
+        self.scene.prefetch_leaf(leaf);
     }
 }
 

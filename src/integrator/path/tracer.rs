@@ -7,6 +7,7 @@
 
 use super::ball_connection::{Departure, Passage, radiance_by_balls};
 use super::lens_connection::LensView;
+use crate::accel::{Portable, Traversal};
 use crate::color::Color;
 use crate::geometry::{Bounce, SurfaceHit};
 use crate::integrator::bsdf_inputs::bsdf_inputs_drawn;
@@ -120,16 +121,26 @@ impl PathTracer {
     /// `C::emission` (an emitter may have a spectrum of its own).
     fn trace<C: Radiance>(&self, scene: &Scene, ray: Ray, sampler: &mut Sampler, wavelengths: &mut C::Wavelengths) -> C {
         let light_sampling = self.light_sampling && !scene.lights.is_empty();
-        match light_sampling && !scene.specular_balls().is_empty() {
-            true => self.trace_with::<C, true>(scene, ray, sampler, wavelengths),
-            false => self.trace_with::<C, false>(scene, ray, sampler, wavelengths),
+        match (light_sampling && !scene.specular_balls().is_empty(), scene.bvh().avx2()) {
+            (true, _) => self.trace_with::<C, true>(Portable, scene, ray, sampler, wavelengths),
+            // The loop compiled for AVX2 with its traversals inside (the
+            // BVH's kernel: see `accel::kernel`).
+            (false, Some(avx2)) => avx2.run(
+                #[inline(always)]
+                || self.trace_with::<C, false>(avx2, scene, ray, sampler, wavelengths),
+            ),
+            (false, _) => self.trace_with::<C, false>(Portable, scene, ray, sampler, wavelengths),
         }
     }
 
-    /// [`trace`](Self::trace), compiled twice: scenes without specular
-    /// balls (`BALLS` false) carry none of the connections' bookkeeping.
+    /// [`trace`](Self::trace), compiled three times: scenes without
+    /// specular balls (`BALLS` false) carry none of the connections'
+    /// bookkeeping, and their loop is compiled for each kernel, with the
+    /// nearest-hit traversal (`traversal`) inside it.
+    #[inline(always)]
     fn trace_with<C: Radiance, const BALLS: bool>(
         &self,
+        traversal: impl Traversal,
         scene: &Scene,
         mut ray: Ray,
         sampler: &mut Sampler,
@@ -164,7 +175,7 @@ impl PathTracer {
             let draws = BounceDraws::new(sampler, light_sampling, scene.lights.len() > 1);
             let found = match balls {
                 true => scene.intersect_leaving(&ray, f64::INFINITY, leaving),
-                false => scene.intersect_leaving_inlined(&ray, f64::INFINITY, leaving),
+                false => scene.intersect_leaving_inlined(traversal, &ray, f64::INFINITY, leaving),
             };
             let Some(intersection) = found else {
                 radiance += throughput * C::from_rgb(scene.background, wavelengths);
