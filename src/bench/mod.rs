@@ -101,7 +101,7 @@ pub fn build_note() -> String {
         ""
     };
     let queries = match crate::accel::Kernel::chosen() {
-        crate::accel::Kernel::Avx2 => "; ray queries and path loop run compiled for AVX2 (chosen at run time)",
+        crate::accel::Kernel::Avx2 => "; ray queries and path loop compiled for AVX2, chosen at run time",
         crate::accel::Kernel::Portable => "",
     };
     format!("{kind} build for {instruction_set}{profile}{queries}")
