@@ -6,13 +6,15 @@
 //! - [`collapse`]: which binary nodes become eight-wide nodes;
 //! - [`bvh`]: the eight-wide tree collapsed from it, and its traversal;
 //! - [`bounds`]: the outward-rounded single-precision boxes both use;
-//! - [`kernel`]: which instructions the queries run with, chosen at run time.
+//! - [`kernel`]: which instructions the queries run with, chosen at run time;
+//! - `slab_test`: the conservative box test of a node's children.
 
 pub mod bounds;
 pub mod build;
 pub mod bvh;
 pub mod collapse;
 pub mod kernel;
+mod slab_test;
 
 pub use build::LeafKind;
 pub use bvh::{BuildPrimitive, Bvh, Dispatched, Leaf, LeafVisitor, Portable, Traversal, TraversalRay};

@@ -12,6 +12,7 @@ pub mod load;
 pub mod progress;
 pub mod similarity;
 pub mod specular_balls;
+mod visitors;
 
 pub use error::{Location, SceneError};
 pub use load::{COORDINATE_LIMIT, LoadedScene, load_scene_bytes, load_scene_file, load_scene_str, load_scene_str_edited};
@@ -19,16 +20,16 @@ pub use progress::{LoadStage, load_scene_file_with_progress};
 pub use similarity::{Similarity, load_scene_str_placed};
 pub use specular_balls::{MAX_SPECULAR_BALLS, SpecularBall};
 
-use crate::accel::{BuildPrimitive, Bvh, Dispatched, Kernel, Leaf, LeafKind, LeafVisitor, Traversal};
+use crate::accel::{BuildPrimitive, Bvh, Dispatched, Kernel, Leaf, LeafKind, Traversal};
 use crate::color::Color;
 use crate::geometry::clipped_sphere::clip_emitters;
 use crate::geometry::spheres::Spheres;
-use crate::geometry::triangle::TriangleRay;
-use crate::geometry::triangles::{LeafHit, TriangleSource, Triangles, store_mesh_positions, stored_position};
-use crate::geometry::{Mesh, Shape, ShapeHit, Sphere, SurfaceHit, Triangle};
+use crate::geometry::triangles::{TriangleSource, Triangles, store_mesh_positions, stored_position};
+use crate::geometry::{Mesh, Shape, Sphere, SurfaceHit, Triangle};
 use crate::light::{Emitter, EmitterSource, Light, Lights};
 use crate::material::{Material, Texture};
 use crate::math::{Aabb, Ray};
+use visitors::{Nearest, NearestVisitor, OcclusionVisitor};
 
 /// The TOML text of the scene compiled into the binary.
 pub const DEFAULT_SCENE: &str = include_str!("../../scenes/cornell.toml");
@@ -402,7 +403,7 @@ impl Scene {
 
     /// Nearest hit in `(0, t_max)`. Triangles report only distance and
     /// barycentrics during traversal, other shapes what their test found
-    /// ([`ShapeHit`]); the hit record (normals, uv, error bounds) is built
+    /// ([`crate::geometry::ShapeHit`]); the hit record (normals, uv, error bounds) is built
     /// once, for the final hit, from those results.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<Intersection> {
@@ -540,118 +541,6 @@ impl EmitterSource for Scene {
             Some(triangle) => Emitter::Triangle(self.triangles.get(triangle)),
             None => Emitter::Shape(&self.shapes[primitive as usize].shape),
         }
-    }
-}
-
-/// The nearest hit so far. Candidates are compared by distance
-/// alone; the hit record (normal, uv, error bounds) is built once,
-/// for the nearest, except for surfaces of revolution, whose root
-/// finding depends on the bound and so keeps the record it found.
-enum Nearest {
-    Nothing,
-    Triangle(LeafHit),
-    Shape(u32, ShapeHit),
-    Record(Intersection),
-}
-
-/// The nearest-hit query's leaf test: lowers `t_max` and records each
-/// nearer hit; shape `skipped` is passed over when `SKIP`.
-struct NearestVisitor<'a, const SKIP: bool> {
-    scene: &'a Scene,
-    ray: &'a Ray,
-    skipped: u32,
-    /// The triangle test's per-ray constants, made when a triangle leaf is first reached.
-    triangle_ray: Option<TriangleRay>,
-    nearest: Nearest,
-}
-
-impl<const SKIP: bool> LeafVisitor for NearestVisitor<'_, SKIP> {
-    #[inline(always)]
-    fn visit(&mut self, leaf: Leaf, t_max: &mut f64) -> bool {
-        if leaf.kind == TRIANGLE_LEAF {
-            let triangle_ray = self.triangle_ray.get_or_insert_with(|| TriangleRay::new(self.ray));
-            if let Some(found) = self
-                .scene
-                .triangles
-                .intersect_leaf(triangle_ray, leaf.first, leaf.count, *t_max)
-            {
-                *t_max = found.hit.t;
-                self.nearest = Nearest::Triangle(found);
-            }
-        } else if leaf.kind == SPHERE_LEAF {
-            if let Some(found) = self.scene.spheres.intersect_leaf(self.ray, leaf.first, leaf.count, *t_max) {
-                *t_max = found.t;
-                self.nearest = Nearest::Shape(self.scene.first_sphere + found.index, ShapeHit::Sphere(found.t));
-            }
-        } else {
-            for index in leaf.first..leaf.first + leaf.count {
-                if SKIP && index == self.skipped {
-                    continue;
-                }
-                let shape = &self.scene.shapes[index as usize].shape;
-                if let Shape::Revolution(revolution) = shape {
-                    if let Some(hit) = revolution.intersect(self.ray, *t_max) {
-                        *t_max = hit.t;
-                        self.nearest = Nearest::Record(Intersection { hit, primitive: index });
-                    }
-                } else if let Some(hit) = shape.nearest_hit(self.ray, *t_max) {
-                    *t_max = hit.t();
-                    self.nearest = Nearest::Shape(index, hit);
-                }
-            }
-        }
-        false
-    }
-
-    #[inline(always)]
-    fn prefetch(&self, leaf: Leaf) {
-        self.scene.prefetch_leaf(leaf);
-    }
-}
-
-/// The any-hit query's leaf test: whether anything in a leaf but shapes
-/// `skipped` (when `SKIP`) lies on the ray before `t_max`.
-struct OcclusionVisitor<'a, const SKIP: bool> {
-    scene: &'a Scene,
-    ray: &'a Ray,
-    skipped: (u32, u32),
-    triangle_ray: Option<TriangleRay>,
-    found: bool,
-}
-
-impl<const SKIP: bool> LeafVisitor for OcclusionVisitor<'_, SKIP> {
-    #[inline(always)]
-    fn visit(&mut self, leaf: Leaf, t_max: &mut f64) -> bool {
-        self.found = {
-            if leaf.kind == TRIANGLE_LEAF {
-                let triangle_ray = self.triangle_ray.get_or_insert_with(|| TriangleRay::new(self.ray));
-                self.scene
-                    .triangles
-                    .occludes_leaf(triangle_ray, leaf.first, leaf.count, *t_max)
-            } else if leaf.kind == SPHERE_LEAF {
-                self.scene.spheres.occludes_leaf(self.ray, leaf.first, leaf.count, *t_max)
-            } else {
-                let mut found = false;
-                for index in leaf.first..leaf.first + leaf.count {
-                    if !(SKIP && (index == self.skipped.0 || index == self.skipped.1))
-                        && self.scene.shapes[index as usize]
-                            .shape
-                            .hit_distance(self.ray, *t_max)
-                            .is_some()
-                    {
-                        found = true;
-                        break;
-                    }
-                }
-                found
-            }
-        };
-        self.found
-    }
-
-    #[inline(always)]
-    fn prefetch(&self, leaf: Leaf) {
-        self.scene.prefetch_leaf(leaf);
     }
 }
 
