@@ -341,9 +341,10 @@ fn rays_at_vertices_visit_every_leaf_the_triangle_test_hits() {
             let mut t = f64::INFINITY;
             scene.bvh().traverse(&ray, &mut t, |leaf, t_max| {
                 visited.extend((leaf.first..leaf.first + leaf.count).map(|k| scene.triangles().source(k).face));
-                if let Some(found) = scene
-                    .triangles()
-                    .intersect_leaf(&triangle_ray, leaf.first, leaf.count, *t_max)
+                if let Some(found) =
+                    scene
+                        .triangles()
+                        .intersect_leaf(scene.bvh().avx2(), &triangle_ray, leaf.first, leaf.count, *t_max)
                 {
                     *t_max = found.hit.t;
                 }

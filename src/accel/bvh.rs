@@ -129,7 +129,10 @@ impl Leaf {
 pub trait LeafVisitor {
     /// Tests `leaf`'s primitives, lowers `*t_max` to the nearest hit it
     /// finds, and returns true to end the traversal.
-    fn visit(&mut self, leaf: Leaf, t_max: &mut f64) -> bool;
+    /// `avx2` is present when the traversal calling it is the AVX2 copy
+    /// (the proof that the CPU has AVX2, for leaf tests of their own in
+    /// those instructions), and is a constant in each copy.
+    fn visit(&mut self, leaf: Leaf, t_max: &mut f64, avx2: Option<Avx2>) -> bool;
 
     /// Starts loading the primitives of `leaf`, which the traversal has
     /// deferred (called only in trees larger than the caches).
@@ -162,7 +165,7 @@ pub struct Portable;
 impl Traversal for Portable {
     #[inline(always)]
     fn nearest(self, bvh: &Bvh, ray: &Ray, t_max: &mut f64, visitor: &mut impl LeafVisitor) {
-        bvh.traverse_compiled::<true, false>(ray, t_max, visitor);
+        bvh.traverse_compiled::<true>(None, ray, t_max, visitor);
     }
 }
 
@@ -171,7 +174,7 @@ impl Traversal for Portable {
 impl Traversal for Avx2 {
     #[inline(always)]
     fn nearest(self, bvh: &Bvh, ray: &Ray, t_max: &mut f64, visitor: &mut impl LeafVisitor) {
-        bvh.traverse_compiled::<true, true>(ray, t_max, visitor);
+        bvh.traverse_compiled::<true>(Some(self), ray, t_max, visitor);
     }
 }
 
@@ -180,7 +183,7 @@ struct VisitFn<F>(F);
 
 impl<F: FnMut(Leaf, &mut f64) -> bool> LeafVisitor for VisitFn<F> {
     #[inline(always)]
-    fn visit(&mut self, leaf: Leaf, t_max: &mut f64) -> bool {
+    fn visit(&mut self, leaf: Leaf, t_max: &mut f64, _avx2: Option<Avx2>) -> bool {
         (self.0)(leaf, t_max)
     }
 }
@@ -374,18 +377,19 @@ impl Bvh {
         match self.avx2 {
             Some(avx2) => avx2.run(
                 #[inline(always)]
-                || self.traverse_compiled::<NEAREST_FIRST, true>(ray, t_max, visitor),
+                || self.traverse_compiled::<NEAREST_FIRST>(Some(avx2), ray, t_max, visitor),
             ),
-            None => self.traverse_compiled::<NEAREST_FIRST, false>(ray, t_max, visitor),
+            None => self.traverse_compiled::<NEAREST_FIRST>(None, ray, t_max, visitor),
         }
     }
 
-    /// The traversal, compiled into whichever function calls it. `AVX2`:
-    /// with AVX2's node test, which only code reached through an [`Avx2`]
-    /// (the proof that the CPU has it) may ask for.
+    /// The traversal, compiled into whichever function calls it. With
+    /// `avx2` (the proof that the CPU has AVX2; a constant wherever this is
+    /// compiled in): AVX2's node test, and the visitor's own AVX2 tests.
     #[inline(always)]
-    fn traverse_compiled<const NEAREST_FIRST: bool, const AVX2: bool>(
+    fn traverse_compiled<const NEAREST_FIRST: bool>(
         &self,
+        avx2: Option<Avx2>,
         ray: &Ray,
         t_max: &mut f64,
         visitor: &mut impl LeafVisitor,
@@ -396,12 +400,13 @@ impl Bvh {
         // Prepared here, in this frame, so the 432-byte record is never copied.
         let ray = &TraversalRay::new(ray);
         let mut stack = TraversalStack::new();
-        self.traverse_with::<NEAREST_FIRST, AVX2>(&mut stack, ray, t_max, visitor);
+        self.traverse_with::<NEAREST_FIRST>(avx2, &mut stack, ray, t_max, visitor);
     }
 
     #[inline(always)]
-    fn traverse_with<const NEAREST_FIRST: bool, const AVX2: bool>(
+    fn traverse_with<const NEAREST_FIRST: bool>(
         &self,
+        avx2: Option<Avx2>,
         stack: &mut TraversalStack,
         ray: &TraversalRay,
         t_max: &mut f64,
@@ -428,7 +433,7 @@ impl Bvh {
         loop {
             if current & LEAF_BIT == 0 {
                 let node = &self.nodes[current as usize];
-                let (t_near, hit) = ray.enter(node, limit, AVX2);
+                let (t_near, hit) = ray.enter(node, limit, avx2);
                 // Whether the ray enters none, one or several children is a
                 // branch that often mispredicts, so it is decided by bit
                 // tests that resolve at once, and the entered children are
@@ -476,7 +481,7 @@ impl Bvh {
                     continue;
                 }
             } else {
-                if visitor.visit(Leaf::from_reference(current), t_max) {
+                if visitor.visit(Leaf::from_reference(current), t_max, avx2) {
                     return;
                 }
                 limit = traversal_limit(*t_max);
@@ -685,7 +690,7 @@ mod tests {
     }
 
     impl<F: FnMut(Leaf, &mut f64) -> bool> LeafVisitor for Counting<'_, F> {
-        fn visit(&mut self, leaf: Leaf, t_max: &mut f64) -> bool {
+        fn visit(&mut self, leaf: Leaf, t_max: &mut f64, _avx2: Option<Avx2>) -> bool {
             (self.visit)(leaf, t_max)
         }
 

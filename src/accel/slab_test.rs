@@ -6,6 +6,7 @@
 
 use super::bounds::{round_up, sign_mask32};
 use super::bvh::{Node, WIDTH};
+use super::kernel::Avx2;
 use crate::math::Ray;
 use wide::{CmpLe, f32x8};
 
@@ -88,15 +89,14 @@ impl TraversalRay {
         }
     }
 
-    /// [`TraversalRay::enter_children`], in AVX2 instructions when `avx2`
-    /// (a constant: the traversal is compiled once with each, and the
-    /// AVX2 copy is reached only through functions that take an [`Avx2`],
-    /// the proof that the CPU has it).
+    /// [`TraversalRay::enter_children`], in AVX2 instructions when given
+    /// `avx2`, the proof that the CPU has them (a constant in each compiled
+    /// copy of the traversal).
     #[inline(always)]
-    pub(super) fn enter(&self, node: &Node, t_max: f32, avx2: bool) -> ([f32; WIDTH], u32) {
+    pub(super) fn enter(&self, node: &Node, t_max: f32, avx2: Option<Avx2>) -> ([f32; WIDTH], u32) {
         #[cfg(target_arch = "x86_64")]
-        if avx2 {
-            // SAFETY: see above: this CPU has AVX2.
+        if avx2.is_some() {
+            // SAFETY: `avx2` exists only if this CPU has AVX2 (`Avx2::detect`).
             #[allow(unsafe_code)]
             return unsafe { self.enter_children_avx2(node, t_max) };
         }

@@ -6,7 +6,7 @@
 //! `accel::kernel`) carries its own copy of the tests.
 
 use super::{Intersection, SPHERE_LEAF, Scene, TRIANGLE_LEAF};
-use crate::accel::{Leaf, LeafVisitor};
+use crate::accel::{Avx2, Leaf, LeafVisitor};
 use crate::geometry::triangle::TriangleRay;
 use crate::geometry::triangles::LeafHit;
 use crate::geometry::{Shape, ShapeHit};
@@ -36,13 +36,13 @@ pub(super) struct NearestVisitor<'a, const SKIP: bool> {
 
 impl<const SKIP: bool> LeafVisitor for NearestVisitor<'_, SKIP> {
     #[inline(always)]
-    fn visit(&mut self, leaf: Leaf, t_max: &mut f64) -> bool {
+    fn visit(&mut self, leaf: Leaf, t_max: &mut f64, avx2: Option<Avx2>) -> bool {
         if leaf.kind == TRIANGLE_LEAF {
             let triangle_ray = self.triangle_ray.get_or_insert_with(|| TriangleRay::new(self.ray));
             if let Some(found) = self
                 .scene
                 .triangles
-                .intersect_leaf(triangle_ray, leaf.first, leaf.count, *t_max)
+                .intersect_leaf(avx2, triangle_ray, leaf.first, leaf.count, *t_max)
             {
                 *t_max = found.hit.t;
                 self.nearest = Nearest::Triangle(found);
@@ -90,12 +90,12 @@ pub(super) struct OcclusionVisitor<'a, const SKIP: bool> {
 
 impl<const SKIP: bool> LeafVisitor for OcclusionVisitor<'_, SKIP> {
     #[inline(always)]
-    fn visit(&mut self, leaf: Leaf, t_max: &mut f64) -> bool {
+    fn visit(&mut self, leaf: Leaf, t_max: &mut f64, avx2: Option<Avx2>) -> bool {
         self.found = if leaf.kind == TRIANGLE_LEAF {
             let triangle_ray = self.triangle_ray.get_or_insert_with(|| TriangleRay::new(self.ray));
             self.scene
                 .triangles
-                .occludes_leaf(triangle_ray, leaf.first, leaf.count, *t_max)
+                .occludes_leaf(avx2, triangle_ray, leaf.first, leaf.count, *t_max)
         } else if leaf.kind == SPHERE_LEAF {
             self.scene.spheres.occludes_leaf(self.ray, leaf.first, leaf.count, *t_max)
         } else {

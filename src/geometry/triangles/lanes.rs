@@ -13,8 +13,19 @@
 //! one after another, is replayed lane by lane by the caller
 //! ([`Candidates::nearest`]). The maxima use the NaN-ignoring `max` of
 //! `f64::max`, so even non-finite inputs give the scalar answers.
+//!
+//! The test is compiled twice, as the BVH's traversal is
+//! (`accel::kernel`): with `wide`'s vectors, which are two SSE2 halves in a
+//! baseline x86-64 build, and in four-lane AVX instructions ([`avx2`]) for
+//! the AVX2 copy of the traversal. Both perform the same operations in the
+//! same order, so they too agree bit for bit.
+
+#[cfg(target_arch = "x86_64")]
+mod avx2;
 
 use super::super::triangle::{TriangleHit, TriangleRay};
+use super::LeafData;
+use crate::accel::Avx2;
 use crate::math::gamma;
 use crate::math::lane_mask::set_lanes;
 use wide::{CmpEq, CmpGe, CmpGt, CmpLe, CmpLt, f64x4};
@@ -76,12 +87,26 @@ impl Candidates {
     }
 }
 
-/// Tests the triangles of the lanes in `active` (bit i for lane i), whose
-/// vertices are `vertices` (each over the four lanes, its coordinates
-/// already in the ray's permuted axis order), for hits in `(0, t_max)`;
-/// `None` when no lane is hit (so `Some` answers an any-hit query).
+/// Tests the triangles of `leaf` for hits in `(0, t_max)`; `None` when no
+/// lane is hit (so `Some` answers an any-hit query). In AVX instructions
+/// when given `avx2`, the proof that the CPU has them.
 #[inline(always)]
-pub fn intersect(ray: &TriangleRay, vertices: &[[Lanes; 3]; 3], active: u32, t_max: f64) -> Option<Candidates> {
+pub(super) fn intersect(avx2: Option<Avx2>, ray: &TriangleRay, leaf: &LeafData, t_max: f64) -> Option<Candidates> {
+    #[cfg(target_arch = "x86_64")]
+    if let Some(avx2) = avx2 {
+        return avx2::intersect(avx2, ray, leaf, t_max);
+    }
+    let _ = avx2;
+    intersect_portable(ray, leaf, t_max)
+}
+
+/// The test in `wide`'s vectors.
+#[inline(always)]
+fn intersect_portable(ray: &TriangleRay, leaf: &LeafData, t_max: f64) -> Option<Candidates> {
+    // Vertex i's coordinate on the permuted axis j, as anchor + offset.
+    let vertices: [[Lanes; 3]; 3] = std::array::from_fn(|vertex| {
+        std::array::from_fn(|j| Lanes::new(leaf.anchors[j]) + Lanes::new(leaf.offsets(3 * vertex + ray.axes[j]).map(f64::from)))
+    });
     let origin = ray.origin.map(Lanes::splat);
     let (shear_x, shear_y) = (Lanes::splat(ray.shear_x), Lanes::splat(ray.shear_y));
     // Translate to the ray origin, permute, shear so the ray is +z.
@@ -100,7 +125,7 @@ pub fn intersect(ray: &TriangleRay, vertices: &[[Lanes; 3]; 3], active: u32, t_m
     let det = e0 + e1 + e2;
     // Rejected: mixed signs, or a zero determinant.
     let rejected = (any_negative & any_positive) | det.cmp_eq(zero);
-    let mut mask = active & !(rejected.move_mask() as u32);
+    let mut mask = leaf.active() & !(rejected.move_mask() as u32);
     if mask == 0 {
         return None;
     }

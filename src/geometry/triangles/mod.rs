@@ -33,9 +33,8 @@ mod lanes;
 
 use super::mesh::Mesh;
 use super::triangle::{Triangle, TriangleHit, TriangleRay};
-use crate::accel::Leaf;
+use crate::accel::{Avx2, Leaf};
 use glam::DVec3;
-use lanes::Lanes;
 
 /// Which face of which mesh a stored triangle is, and its material.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -86,6 +85,33 @@ pub struct Triangles {
     /// The anchor of every triangle when they all share one (the common
     /// case of one mesh), which spares the leaf test a gather per lane.
     shared_anchor: Option<DVec3>,
+}
+
+/// A leaf as the four-lane tests ([`lanes`]) read it.
+struct LeafData<'a> {
+    /// The [`LEAF_FLOATS`] offsets from the leaf's first.
+    block: &'a [f32; LEAF_FLOATS],
+    /// Its number of triangles, 1 to 4.
+    count: usize,
+    /// Per permuted axis of the ray, the anchor of each lane's mesh.
+    anchors: [[f64; 4]; 3],
+}
+
+impl LeafData<'_> {
+    /// Coordinate `k` (x, y, z of vertex 0, then 1 and 2) of the four
+    /// lanes' triangles: four offsets from `k · count`. As `k ≤ 8` and
+    /// `count ≤ 4`, the clamp changes nothing but spares a bounds check.
+    #[inline(always)]
+    fn offsets(&self, k: usize) -> [f32; 4] {
+        let start = (k * self.count).min(LEAF_FLOATS - 4);
+        std::array::from_fn(|lane| self.block[start..start + 4][lane])
+    }
+
+    /// Bit i set for each lane holding one of the leaf's triangles.
+    #[inline(always)]
+    fn active(&self) -> u32 {
+        (1 << self.count) - 1
+    }
 }
 
 /// The nearest triangle hit found in a leaf.
@@ -196,33 +222,26 @@ impl Triangles {
         }
     }
 
-    /// The stored vertices of the leaf's triangles, one triangle per lane,
-    /// with their axes in the ray's permuted order (`vertices[i][j]` is
-    /// vertex i's coordinate on axis `ray.axes[j]`), as anchor + offset in
-    /// `f64`, exactly as [`Triangles::get`] makes them. The leaf's block is
-    /// read as one window, so each coordinate is one four-float load.
+    /// What the four-lane tests read of the leaf of triangles
+    /// `first .. first + count`: its window of offsets and, per lane, the
+    /// anchor of its triangle's mesh along each of the ray's permuted axes.
     #[inline(always)]
-    fn leaf_vertices(&self, ray: &TriangleRay, first: u32, count: u32) -> Option<[[Lanes; 3]; 3]> {
-        let (first, n) = (first as usize, count as usize);
+    fn leaf_data(&self, ray: &TriangleRay, first: u32, count: u32) -> Option<LeafData<'_>> {
+        let first = first as usize;
         let block: &[f32; LEAF_FLOATS] = self.offsets.get(9 * first..)?.first_chunk()?;
-        let anchor: [Lanes; 3] = match self.shared_anchor {
-            Some(anchor) => ray.axes.map(|axis| Lanes::splat(anchor[axis])),
+        let anchors = match self.shared_anchor {
+            Some(anchor) => ray.axes.map(|axis| [anchor[axis]; 4]),
             None => {
                 let words: [u32; 4] = std::array::from_fn(|lane| self.records[first + lane].placement);
                 let anchors = words.map(|word| self.anchor(word & MESH_MASK));
-                ray.axes.map(|axis| Lanes::new(anchors.map(|a| a[axis])))
+                ray.axes.map(|axis| anchors.map(|a| a[axis]))
             }
         };
-        // Coordinate k of the four lanes starts at k·n; k ≤ 8 and n ≤ 4, so
-        // the clamp changes nothing and spares a bounds check per load.
-        let coordinate = |k: usize| {
-            let start = (k * n).min(LEAF_FLOATS - 4);
-            let four: [f32; 4] = std::array::from_fn(|lane| block[start..start + 4][lane]);
-            Lanes::new(four.map(f64::from))
-        };
-        Some(std::array::from_fn(|vertex| {
-            std::array::from_fn(|j| anchor[j] + coordinate(3 * vertex + ray.axes[j]))
-        }))
+        Some(LeafData {
+            block,
+            count: count as usize,
+            anchors,
+        })
     }
 
     /// Starts loading the vertex block of the leaf whose first triangle is
@@ -242,9 +261,9 @@ impl Triangles {
     /// when run over them in order, each with `t_max` lowered to the hit
     /// before it.
     #[inline(always)]
-    pub fn intersect_leaf(&self, ray: &TriangleRay, first: u32, count: u32, t_max: f64) -> Option<LeafHit> {
-        let vertices = self.leaf_vertices(ray, first, count)?;
-        let candidates = lanes::intersect(ray, &vertices, (1 << count) - 1, t_max)?;
+    pub fn intersect_leaf(&self, avx2: Option<Avx2>, ray: &TriangleRay, first: u32, count: u32, t_max: f64) -> Option<LeafHit> {
+        let leaf = self.leaf_data(ray, first, count)?;
+        let candidates = lanes::intersect(avx2, ray, &leaf, t_max)?;
         let (lane, hit) = candidates.nearest(t_max)?;
         let index = first + lane as u32;
         // Start loading the record now, though only the final hit needs it:
@@ -259,9 +278,9 @@ impl Triangles {
 
     /// Whether any of triangles `first .. first + count` (a leaf) is hit in `(0, t_max)`.
     #[inline(always)]
-    pub fn occludes_leaf(&self, ray: &TriangleRay, first: u32, count: u32, t_max: f64) -> bool {
-        self.leaf_vertices(ray, first, count)
-            .and_then(|vertices| lanes::intersect(ray, &vertices, (1 << count) - 1, t_max))
+    pub fn occludes_leaf(&self, avx2: Option<Avx2>, ray: &TriangleRay, first: u32, count: u32, t_max: f64) -> bool {
+        self.leaf_data(ray, first, count)
+            .and_then(|leaf| lanes::intersect(avx2, ray, &leaf, t_max))
             .is_some()
     }
 }
@@ -314,8 +333,9 @@ mod tests {
     /// Two meshes of a jittered height field sharing vertices between
     /// faces, the second 10⁵ units away (its own anchor), with every fifth
     /// face repeated (equal distances inside one leaf), in leaves of every
-    /// size 1–4: the four-lane test must give the scalar test's answers
-    /// bit for bit, including at shared edges and vertices and at ties.
+    /// size 1–4: the four-lane test, in both its copies (baseline x86-64
+    /// and AVX2), must give the scalar test's answers bit for bit,
+    /// including at shared edges and vertices and at ties.
     #[test]
     fn leaf_test_matches_the_scalar_test_bit_for_bit() {
         let mut random = Lcg(7);
@@ -399,11 +419,14 @@ mod tests {
                             scalar = Some(LeafHit { index, hit });
                         }
                     }
-                    let lanes = stored.intersect_leaf(&triangle_ray, leaf.first, leaf.count, t_max);
                     let bits = |h: Option<LeafHit>| h.map(|h| (h.index, h.hit.t.to_bits(), h.hit.barycentric.map(f64::to_bits)));
-                    assert_eq!(bits(lanes), bits(scalar), "{ray:?} leaf {leaf:?} t_max {t_max}");
-                    let occluded = stored.occludes_leaf(&triangle_ray, leaf.first, leaf.count, t_max);
-                    assert_eq!(occluded, scalar.is_some());
+                    // Both compiled copies of the test, where the CPU has AVX2.
+                    for avx2 in [None, Avx2::detect()] {
+                        let lanes = stored.intersect_leaf(avx2, &triangle_ray, leaf.first, leaf.count, t_max);
+                        assert_eq!(bits(lanes), bits(scalar), "{ray:?} leaf {leaf:?} t_max {t_max} {avx2:?}");
+                        let occluded = stored.occludes_leaf(avx2, &triangle_ray, leaf.first, leaf.count, t_max);
+                        assert_eq!(occluded, scalar.is_some());
+                    }
                     if let Some(hit) = scalar {
                         hits += 1;
                         edge_hits += usize::from(hit.hit.barycentric.contains(&0.0));
