@@ -10,8 +10,9 @@
 //! viewer and the benchmarks share. [`farm`] splits a render across machines
 //! and merges the parts' films exactly.
 
-// Only the run-time choice of AVX2 kernels may use `unsafe` (two
-// commented calls, src/accel/kernel.rs and src/accel/bvh.rs).
+// Only the run-time choice of AVX2 kernels may use `unsafe` (three
+// commented calls into code compiled for AVX2: src/accel/kernel.rs,
+// src/accel/slab_test.rs, src/geometry/triangles/lanes/avx2.rs).
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 
