@@ -193,6 +193,9 @@ impl Lights {
     }
 
     /// Samples a point on a light as seen from `reference`.
+    // Always inlined: compiled into each copy of the path loop (baseline,
+    // AVX2: `accel::kernel`) rather than called from it in baseline code.
+    #[inline(always)]
     pub fn sample(&self, source: &impl EmitterSource, reference: DVec3, u_select: f64, u: DVec2) -> Option<LightSample<'_>> {
         let (index, selection) = self.choose(u_select)?;
         let light = &self.lights[index as usize];

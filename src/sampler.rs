@@ -126,6 +126,9 @@ impl Sampler {
     }
 
     /// Two uniform values in [0, 1)², stratified together.
+    // Always inlined, so each copy of the path loop (baseline, AVX2) has
+    // its own, and the hashes overlap the work around them.
+    #[inline(always)]
     pub fn next_2d(&mut self) -> DVec2 {
         let dimension_seed = self.next_dimension_seed();
         match self.kind {

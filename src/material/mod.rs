@@ -211,6 +211,9 @@ impl Material {
     }
 
     /// Draws `wi` for the given `wo`; `u` picks the direction, `u_lobe` the lobe.
+    // Always inlined: compiled into each copy of the path loop (baseline,
+    // AVX2: `accel::kernel`) rather than called from it in baseline code.
+    #[inline(always)]
     pub fn sample(&self, wo: DVec3, at: &ShadingPoint, u: DVec2, u_lobe: f64, transport: Transport) -> Option<BsdfSample> {
         match self {
             Material::Diffuse { albedo } => diffuse::sample(albedo.evaluate(at), wo, u),

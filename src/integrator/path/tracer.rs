@@ -40,7 +40,9 @@ struct BounceDraws {
 }
 
 impl BounceDraws {
-    #[inline]
+    // Always inlined, with the sampler's `next_2d`, so the draws are
+    // compiled into each copy of the path loop (AVX2's included).
+    #[inline(always)]
     fn new(sampler: &mut Sampler, light_sampling: bool, several_lights: bool) -> Self {
         let light_choice = match several_lights {
             true => Some(sampler.defer_1d()),
