@@ -10,9 +10,10 @@
 //! viewer and the benchmarks share. [`farm`] splits a render across machines
 //! and merges the parts' films exactly.
 
-// Only the run-time choice of AVX2 kernels may use `unsafe` (three
-// commented calls into code compiled for AVX2: src/accel/kernel.rs,
-// src/accel/slab_test.rs, src/geometry/triangles/lanes/avx2.rs).
+// Only the run-time choice of AVX2 kernels may use `unsafe` (commented
+// calls into code compiled for AVX2, in src/accel/kernel.rs,
+// src/accel/slab_test.rs, src/geometry/triangles/lanes/avx2.rs and
+// src/geometry/spheres/mod.rs).
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 

@@ -48,7 +48,11 @@ impl<const SKIP: bool> LeafVisitor for NearestVisitor<'_, SKIP> {
                 self.nearest = Nearest::Triangle(found);
             }
         } else if leaf.kind == SPHERE_LEAF {
-            if let Some(found) = self.scene.spheres.intersect_leaf(self.ray, leaf.first, leaf.count, *t_max) {
+            if let Some(found) = self
+                .scene
+                .spheres
+                .intersect_leaf(avx2, self.ray, leaf.first, leaf.count, *t_max)
+            {
                 *t_max = found.t;
                 self.nearest = Nearest::Shape(self.scene.first_sphere + found.index, ShapeHit::Sphere(found.t));
             }
@@ -97,7 +101,9 @@ impl<const SKIP: bool> LeafVisitor for OcclusionVisitor<'_, SKIP> {
                 .triangles
                 .occludes_leaf(avx2, triangle_ray, leaf.first, leaf.count, *t_max)
         } else if leaf.kind == SPHERE_LEAF {
-            self.scene.spheres.occludes_leaf(self.ray, leaf.first, leaf.count, *t_max)
+            self.scene
+                .spheres
+                .occludes_leaf(avx2, self.ray, leaf.first, leaf.count, *t_max)
         } else {
             // A plain loop, not `any`: its closure stayed out of line.
             let mut found = false;

@@ -18,12 +18,21 @@
 //! ([`Spheres::intersect_leaf`]): a leaf reports the sphere and distance a
 //! scalar loop over it would.
 //!
+//! The vector part (the four pairs of roots) is compiled twice, as the
+//! BVH's traversal is (`accel::kernel`): with `wide`'s vectors, two SSE2
+//! halves in a baseline build, and in AVX instructions ([`avx2`]) for the
+//! AVX2 traversal; the same operations in the same order, so the same bits.
+//!
 //! **Layout.** Centre x, y, z and radius are four arrays in leaf order, so
 //! four consecutive spheres' values are one load each. Lanes past a leaf's
 //! count read the next leaf's spheres (or zeros, which the arrays end with)
 //! and are masked off.
 
+#[cfg(target_arch = "x86_64")]
+mod avx2;
+
 use super::Sphere;
+use crate::accel::Avx2;
 use crate::math::Ray;
 use crate::math::lane_mask::set_lanes;
 use wide::{CmpGt, CmpLt, f64x4};
@@ -148,11 +157,73 @@ impl Spheres {
 
     /// The nearest hit in `(0, t_max)` among spheres `first .. first + count`
     /// (a leaf): the one [`Sphere::hit_distance`] finds when run over them
-    /// in order, each with `t_max` lowered to the hit before it.
-    // Out of line: inlined into the BVH traversal it would cost every
-    // scene registers and spills, sphere leaves or none.
+    /// in order, each with `t_max` lowered to the hit before it. Compiled
+    /// for AVX2 when given `avx2`, the proof that the CPU has it.
+    #[inline(always)]
+    pub fn intersect_leaf(&self, avx2: Option<Avx2>, ray: &Ray, first: u32, count: u32, t_max: f64) -> Option<SphereHit> {
+        #[cfg(target_arch = "x86_64")]
+        if avx2.is_some() {
+            // SAFETY: `avx2` exists only if this CPU has AVX2 (`Avx2::detect`).
+            #[allow(unsafe_code)]
+            return unsafe { self.intersect_leaf_avx2(ray, first, count, t_max) };
+        }
+        let _ = avx2;
+        self.intersect_leaf_portable(ray, first, count, t_max)
+    }
+
+    /// Whether any of spheres `first .. first + count` (a leaf) is hit in
+    /// `(0, t_max)`; compiled for AVX2 when given `avx2`.
+    #[inline(always)]
+    pub fn occludes_leaf(&self, avx2: Option<Avx2>, ray: &Ray, first: u32, count: u32, t_max: f64) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if avx2.is_some() {
+            // SAFETY: `avx2` exists only if this CPU has AVX2 (`Avx2::detect`).
+            #[allow(unsafe_code)]
+            return unsafe { self.occludes_leaf_avx2(ray, first, count, t_max) };
+        }
+        let _ = avx2;
+        self.occludes_leaf_portable(ray, first, count, t_max)
+    }
+
+    // The leaf tests are out of line: inlined into the BVH traversal they
+    // would cost every scene registers and spills, sphere leaves or none.
+    // Each is compiled twice, for baseline x86-64 and for AVX2, as the
+    // traversal is (`accel::kernel`), from the same source: the same
+    // operations in the same order, so the same answers bit for bit.
+
     #[inline(never)]
-    pub fn intersect_leaf(&self, ray: &Ray, first: u32, count: u32, t_max: f64) -> Option<SphereHit> {
+    fn intersect_leaf_portable(&self, ray: &Ray, first: u32, count: u32, t_max: f64) -> Option<SphereHit> {
+        self.intersect_leaf_inlined(ray, first, count, t_max, || self.roots(ray, first, count))
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[inline(never)]
+    fn intersect_leaf_avx2(&self, ray: &Ray, first: u32, count: u32, t_max: f64) -> Option<SphereHit> {
+        self.intersect_leaf_inlined(ray, first, count, t_max, || self.roots_avx2(ray, first, count))
+    }
+
+    #[inline(never)]
+    fn occludes_leaf_portable(&self, ray: &Ray, first: u32, count: u32, t_max: f64) -> bool {
+        self.occludes_leaf_inlined(ray, first, count, t_max, || self.roots(ray, first, count))
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[inline(never)]
+    fn occludes_leaf_avx2(&self, ray: &Ray, first: u32, count: u32, t_max: f64) -> bool {
+        self.occludes_leaf_inlined(ray, first, count, t_max, || self.roots_avx2(ray, first, count))
+    }
+
+    #[inline(always)]
+    fn intersect_leaf_inlined(
+        &self,
+        ray: &Ray,
+        first: u32,
+        count: u32,
+        t_max: f64,
+        roots: impl FnOnce() -> Option<Roots>,
+    ) -> Option<SphereHit> {
         if count <= SCALAR_COUNT {
             // One or two live lanes of four cost more than the scalar tests.
             let mut nearest = None;
@@ -165,7 +236,7 @@ impl Spheres {
             }
             return nearest;
         }
-        let roots = self.roots(ray, first, count)?;
+        let roots = roots()?;
         let mut nearest = None;
         let mut bound = t_max;
         for lane in set_lanes(roots.mask) {
@@ -180,18 +251,22 @@ impl Spheres {
         nearest
     }
 
-    /// Whether any of spheres `first .. first + count` (a leaf) is hit in `(0, t_max)`.
-    // Out of line: inlined into the BVH traversal it would cost every
-    // scene registers and spills, sphere leaves or none.
-    #[inline(never)]
-    pub fn occludes_leaf(&self, ray: &Ray, first: u32, count: u32, t_max: f64) -> bool {
+    #[inline(always)]
+    fn occludes_leaf_inlined(
+        &self,
+        ray: &Ray,
+        first: u32,
+        count: u32,
+        t_max: f64,
+        roots: impl FnOnce() -> Option<Roots>,
+    ) -> bool {
         if count <= SCALAR_COUNT {
             return (first..first + count).any(|index| {
                 self.sphere(index)
                     .is_some_and(|sphere| sphere.hit_distance(ray, t_max).is_some())
             });
         }
-        self.roots(ray, first, count).is_some_and(|roots| {
+        roots().is_some_and(|roots| {
             let (zero, bound) = (f64x4::ZERO, f64x4::splat(t_max));
             let in_range = |t: [f64; 4]| {
                 let t = f64x4::new(t);
@@ -276,13 +351,16 @@ mod tests {
                 let ray = Ray::new(origin, target - origin);
                 for t_max in [f64::INFINITY, random.next() * 2.0] {
                     let expected = scalar_nearest(&spheres, first, count, &ray, t_max);
-                    let found = store.intersect_leaf(&ray, first as u32, count as u32, t_max);
                     let bits = |hit: Option<SphereHit>| hit.map(|h| (h.index, h.t.to_bits()));
-                    assert_eq!(bits(found), bits(expected), "leaf at {first}, {count} spheres, ray {ray:?}");
-                    assert_eq!(
-                        store.occludes_leaf(&ray, first as u32, count as u32, t_max),
-                        expected.is_some()
-                    );
+                    // Both compiled copies, where the CPU has AVX2.
+                    for avx2 in [None, Avx2::detect()] {
+                        let found = store.intersect_leaf(avx2, &ray, first as u32, count as u32, t_max);
+                        assert_eq!(bits(found), bits(expected), "leaf at {first}, {count} spheres, ray {ray:?}");
+                        assert_eq!(
+                            store.occludes_leaf(avx2, &ray, first as u32, count as u32, t_max),
+                            expected.is_some()
+                        );
+                    }
                     hits += usize::from(expected.is_some());
                 }
             }
