@@ -123,6 +123,9 @@ impl Shape {
     /// from the test's own results, or (for other shapes) by the same test
     /// again with the bound just above the hit, which finds the same hit.
     /// Without `with_uv` a sphere's texture coordinates are left (0, 0).
+    // Always inlined: compiled into each copy of the path loop (baseline,
+    // AVX2: `accel::kernel`) rather than called from it in baseline code.
+    #[inline(always)]
     pub fn surface_hit(&self, ray: &Ray, hit: ShapeHit, meshes: &[Mesh], with_uv: bool) -> Option<SurfaceHit> {
         match (self, hit) {
             (Shape::Quad(q), ShapeHit::Quad { t, a, b }) => Some(q.surface_hit(t, a, b)),
