@@ -679,10 +679,6 @@ mod tests {
         }
     }
 
-    /// With prefetching forced on (as in a tree larger than the caches),
-    /// the traversal visits the same leaves and gives the same answers:
-    /// the nearest hit equals brute force's, occlusion agrees, and leaves
-    /// were indeed prefetched.
     /// A visitor that counts the leaves prefetched.
     struct Counting<'a, F> {
         visit: F,
@@ -699,6 +695,10 @@ mod tests {
         }
     }
 
+    /// With prefetching forced on (as in a tree larger than the caches),
+    /// the traversal visits the same leaves and gives the same answers:
+    /// the nearest hit equals brute force's, occlusion agrees, and leaves
+    /// were indeed prefetched.
     #[test]
     fn prefetching_changes_no_answer() {
         let boxes = random_boxes(3000, 777);
