@@ -24,6 +24,9 @@ pub fn pdf(wo: DVec3, wi: DVec3) -> f64 {
 
 /// A cosine-weighted direction on `wo`'s side; the weight is the albedo.
 /// `None` for grazing `wo` (cos θo = 0).
+// Always inlined: compiled into each copy of the path loop (baseline,
+// AVX2: `accel::kernel`) rather than called from it in baseline code.
+#[inline(always)]
 pub fn sample(albedo: Color, wo: DVec3, u: DVec2) -> Option<BsdfSample> {
     if wo.z == 0.0 {
         return None;
