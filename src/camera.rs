@@ -116,6 +116,13 @@ impl Camera {
     /// point on the aperture.
     #[inline]
     pub fn generate_ray(&self, film: DVec2, aspect: f64, lens: DVec2) -> Ray {
+        self.generate_ray_inlined(film, aspect, lens)
+    }
+
+    /// [`Camera::generate_ray`], always compiled into its caller (the
+    /// path tracer's pixel loop through a lens).
+    #[inline(always)]
+    pub fn generate_ray_inlined(&self, film: DVec2, aspect: f64, lens: DVec2) -> Ray {
         let b = &self.basis;
         let x = (2.0 * film.x - 1.0) * b.tan_half_fov_y * aspect;
         let y = (1.0 - 2.0 * film.y) * b.tan_half_fov_y;
@@ -124,7 +131,7 @@ impl Camera {
         let direction = b.forward + x * b.right + y * b.up;
         let mut ray = if self.has_lens() {
             let focus = self.position + self.focal_distance * direction;
-            let origin = self.lens_point(lens);
+            let origin = self.lens_point_inlined(lens);
             Ray::new(origin, focus - origin)
         } else {
             Ray::new(self.position, direction)
@@ -190,6 +197,12 @@ impl Camera {
     /// [`generate_ray`](Self::generate_ray) does (the eye for a pinhole).
     #[inline]
     pub fn lens_point(&self, lens: DVec2) -> DVec3 {
+        self.lens_point_inlined(lens)
+    }
+
+    /// [`Camera::lens_point`], always compiled into its caller.
+    #[inline(always)]
+    fn lens_point_inlined(&self, lens: DVec2) -> DVec3 {
         if self.has_lens() {
             let disk = warp::square_to_concentric_disk(lens) * self.aperture_radius;
             self.position + disk.x * self.basis.right + disk.y * self.basis.up
