@@ -122,7 +122,7 @@ impl Camera {
     /// [`Camera::generate_ray`], always compiled into its caller (the
     /// path tracer's pixel loop through a lens).
     #[inline(always)]
-    pub fn generate_ray_inlined(&self, film: DVec2, aspect: f64, lens: DVec2) -> Ray {
+    pub(crate) fn generate_ray_inlined(&self, film: DVec2, aspect: f64, lens: DVec2) -> Ray {
         let b = &self.basis;
         let x = (2.0 * film.x - 1.0) * b.tan_half_fov_y * aspect;
         let y = (1.0 - 2.0 * film.y) * b.tan_half_fov_y;

@@ -126,11 +126,6 @@ impl PathIntegrator {
     where
         F: Fn(&PathTracer, &Scene, Ray, &mut Sampler) -> crate::color::Color + Sync,
     {
-        let sample_index = self.first_sample + self.passes;
-        let (tracer, kind, seed) = (self.tracer, self.sampler, self.seed);
-        let size = (self.film.width, self.film.height);
-        let (pixels, rows) = (self.settings.sampled_pixels(), self.rows);
-        let threshold = self.adaptive_threshold;
         // A thin lens's camera ray is a longer chain before the path can
         // start (a second draw, the disk map, a normalisation), so through a
         // lens the pixel loop has its own copy with the chain compiled in:
@@ -138,18 +133,28 @@ impl PathIntegrator {
         // stays as it was: compiled the same way, Mitsuba's Cornell box ran
         // level to 2% slower.
         if camera.has_lens() {
-            pass::add_samples_adaptive(&mut self.film, pixels, rows, cancel, threshold, |x, y| {
-                let mut sampler = Sampler::new(kind, y as u64 * size.0 as u64 + x as u64, sample_index, seed);
-                let ray = camera_ray_compiled::<true>(camera, size, x, y, &mut sampler);
-                radiance(&tracer, scene, ray, &mut sampler)
-            })
+            self.add_pass_with(scene, camera, cancel, radiance, camera_ray_compiled::<true>)
         } else {
-            pass::add_samples_adaptive(&mut self.film, pixels, rows, cancel, threshold, |x, y| {
-                let mut sampler = Sampler::new(kind, y as u64 * size.0 as u64 + x as u64, sample_index, seed);
-                let ray = camera_ray(camera, size, x, y, &mut sampler);
-                radiance(&tracer, scene, ray, &mut sampler)
-            })
+            self.add_pass_with(scene, camera, cancel, radiance, camera_ray)
         }
+    }
+
+    /// [`PathIntegrator::add_pass`] with its camera rays made by `camera_ray`.
+    #[inline(always)]
+    fn add_pass_with<F, C>(&mut self, scene: &Scene, camera: &Camera, cancel: &AtomicBool, radiance: F, camera_ray: C) -> bool
+    where
+        F: Fn(&PathTracer, &Scene, Ray, &mut Sampler) -> crate::color::Color + Sync,
+        C: Fn(&Camera, (u32, u32), u32, u32, &mut Sampler) -> Ray + Sync,
+    {
+        let sample_index = self.first_sample + self.passes;
+        let (tracer, kind, seed) = (self.tracer, self.sampler, self.seed);
+        let size = (self.film.width, self.film.height);
+        let (pixels, rows) = (self.settings.sampled_pixels(), self.rows);
+        pass::add_samples_adaptive(&mut self.film, pixels, rows, cancel, self.adaptive_threshold, |x, y| {
+            let mut sampler = Sampler::new(kind, y as u64 * size.0 as u64 + x as u64, sample_index, seed);
+            let ray = camera_ray(camera, size, x, y, &mut sampler);
+            radiance(&tracer, scene, ray, &mut sampler)
+        })
     }
 }
 
