@@ -258,11 +258,14 @@ impl Bvh {
             order.push(item.index());
         }
 
+        // A large tree's nodes on huge pages, asked before they are written.
+        let nodes = Vec::with_capacity(binary.len() / 2 + 1);
+        super::huge_pages::advise(&nodes);
         let mut collapser = Collapser {
             binary: &binary,
             collapse: Collapse::new(&binary),
             index_within_kind: &index_within_kind,
-            nodes: Vec::with_capacity(binary.len() / 2 + 1),
+            nodes,
             leaf_count: 0,
             depth: 0,
         };

@@ -132,8 +132,14 @@ impl Triangles {
     /// stored as mesh 0.
     pub fn new(triangles: &[(Triangle, u32)], order: &[u32], leaves: &[Leaf], anchors: Vec<DVec3>) -> Self {
         let count = order.len();
-        let mut offsets = vec![0.0f32; 9 * count + OFFSET_PADDING];
-        let mut records = vec![Record::default(); count + RECORD_PADDING];
+        // A large mesh's leaves on huge pages (`accel::huge_pages`), asked
+        // before they are written.
+        let mut offsets = Vec::with_capacity(9 * count + OFFSET_PADDING);
+        crate::accel::huge_pages::advise(&offsets);
+        offsets.resize(9 * count + OFFSET_PADDING, 0.0f32);
+        let mut records = Vec::with_capacity(count + RECORD_PADDING);
+        crate::accel::huge_pages::advise(&records);
+        records.resize(count + RECORD_PADDING, Record::default());
         let anchor_of = |mesh: u32| anchors.get(mesh as usize).copied().unwrap_or(DVec3::ZERO);
         for leaf in leaves {
             let n = leaf.count as usize;
