@@ -7,14 +7,14 @@
 //! - [`bvh`]: the eight-wide tree collapsed from it, and its traversal;
 //! - [`bounds`]: the outward-rounded single-precision boxes both use;
 //! - [`kernel`]: which instructions the queries run with, chosen at run time;
-//! - [`huge_pages`]: large arrays asked onto 2 MiB pages;
+//! - `huge_pages`: large arrays asked onto 2 MiB pages;
 //! - `slab_test`: the conservative box test of a node's children.
 
 pub mod bounds;
 pub mod build;
 pub mod bvh;
 pub mod collapse;
-pub mod huge_pages;
+pub(crate) mod huge_pages;
 pub mod kernel;
 mod slab_test;
 
