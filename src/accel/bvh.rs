@@ -258,14 +258,12 @@ impl Bvh {
             order.push(item.index());
         }
 
-        // A large tree's nodes on huge pages, asked before they are written.
-        let nodes = Vec::with_capacity(binary.len() / 2 + 1);
-        super::huge_pages::advise(&nodes);
         let mut collapser = Collapser {
             binary: &binary,
             collapse: Collapse::new(&binary),
             index_within_kind: &index_within_kind,
-            nodes,
+            // A large tree's nodes on huge pages.
+            nodes: super::huge_pages::with_capacity(binary.len() / 2 + 1),
             leaf_count: 0,
             depth: 0,
         };

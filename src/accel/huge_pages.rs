@@ -20,6 +20,15 @@ fn whole_pages(start: usize, bytes: usize) -> Option<std::ops::Range<usize>> {
     (end > first).then_some(first..end)
 }
 
+/// An empty vector with room for `capacity` values whose allocation is
+/// already advised ([`advise`]): the advice comes before any write by
+/// construction.
+pub fn with_capacity<T>(capacity: usize) -> Vec<T> {
+    let values = Vec::with_capacity(capacity);
+    advise(&values);
+    values
+}
+
 /// Asks the kernel to back the huge pages inside `values`' allocation with
 /// huge pages. Call it before anything is written there: pages already
 /// touched keep their size until the kernel collapses them, if ever.

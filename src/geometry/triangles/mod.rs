@@ -33,7 +33,7 @@ mod lanes;
 
 use super::mesh::Mesh;
 use super::triangle::{Triangle, TriangleHit, TriangleRay};
-use crate::accel::{Avx2, Leaf};
+use crate::accel::{Avx2, Leaf, huge_pages};
 use glam::DVec3;
 
 /// Which face of which mesh a stored triangle is, and its material.
@@ -132,13 +132,10 @@ impl Triangles {
     /// stored as mesh 0.
     pub fn new(triangles: &[(Triangle, u32)], order: &[u32], leaves: &[Leaf], anchors: Vec<DVec3>) -> Self {
         let count = order.len();
-        // A large mesh's leaves on huge pages (`accel::huge_pages`), asked
-        // before they are written.
-        let mut offsets = Vec::with_capacity(9 * count + OFFSET_PADDING);
-        crate::accel::huge_pages::advise(&offsets);
+        // A large mesh's leaves on huge pages (`accel::huge_pages`).
+        let mut offsets = huge_pages::with_capacity(9 * count + OFFSET_PADDING);
         offsets.resize(9 * count + OFFSET_PADDING, 0.0f32);
-        let mut records = Vec::with_capacity(count + RECORD_PADDING);
-        crate::accel::huge_pages::advise(&records);
+        let mut records = huge_pages::with_capacity(count + RECORD_PADDING);
         records.resize(count + RECORD_PADDING, Record::default());
         let anchor_of = |mesh: u32| anchors.get(mesh as usize).copied().unwrap_or(DVec3::ZERO);
         for leaf in leaves {
