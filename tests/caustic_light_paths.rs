@@ -6,7 +6,7 @@
 //! one process.
 
 mod common;
-use common::{Job, render, scene};
+use common::{Job, ScratchDir, render, scene};
 use prism::scene::LoadedScene;
 use std::process::Command;
 
@@ -186,14 +186,17 @@ fn light_traced_caustics_are_the_same_on_any_thread_count() {
 /// with parts that have them.
 #[test]
 fn farm_parts_with_light_traced_caustics_merge_into_the_single_process_image() {
-    let folder = std::env::temp_dir().join(format!("prism-caustic-farm-{}", std::process::id()));
-    std::fs::create_dir_all(&folder).expect("temporary folder");
+    let dir = ScratchDir::new(
+        "prism-caustic-farm",
+        "farm_parts_with_light_traced_caustics_merge_into_the_single_process_image",
+    );
+    let folder = dir.path();
     let scene_path = folder.join("caustic.toml");
     std::fs::write(&scene_path, caustic_scene("", "")).expect("scene written");
     let run = |args: &[&str]| {
         let output = Command::new(env!("CARGO_BIN_EXE_prism"))
             .args(args)
-            .current_dir(&folder)
+            .current_dir(folder)
             .output()
             .expect("prism runs");
         (output.status.success(), String::from_utf8_lossy(&output.stderr).to_string())
@@ -223,7 +226,6 @@ fn farm_parts_with_light_traced_caustics_merge_into_the_single_process_image() {
     let (ok, stderr) = run(&["merge", "plain.film", "part-1.film", "-o", "bad.exr"]);
     assert!(!ok, "parts with and without light paths merged");
     assert!(stderr.contains("caustic_light_paths"), "{stderr}");
-    let _ = std::fs::remove_dir_all(&folder);
 }
 
 /// Where light paths can find nothing, nothing changes: the bunny and the

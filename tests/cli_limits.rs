@@ -2,14 +2,14 @@
 //! `[render]` table: every limit is checked before anything is allocated or
 //! rendered, and the error names the flag.
 
-use std::path::PathBuf;
+mod common;
+use common::ScratchDir;
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("prism-cli-limits-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir.join(name)
+/// The test's scratch directory, for the image it must not write.
+fn scratch(test: &str) -> ScratchDir {
+    ScratchDir::new("prism-cli-limits", test)
 }
 
 /// `prism render` of the default scene with `args`.
@@ -23,8 +23,8 @@ fn render(args: &[&str]) -> Output {
 
 /// The command fails with exactly one line starting with `start`, and
 /// writes no image.
-fn refused(args: &[&str], start: &str) {
-    let image = scratch("refused.png");
+fn refused(dir: &ScratchDir, args: &[&str], start: &str) {
+    let image = dir.join("refused.png");
     let mut all = args.to_vec();
     let image_text = image.display().to_string();
     if !args.contains(&"-o") {
@@ -40,12 +40,15 @@ fn refused(args: &[&str], start: &str) {
 
 #[test]
 fn image_size_is_checked_before_allocating() {
+    let dir = scratch("image_size_is_checked_before_allocating");
     refused(
+        &dir,
         &["--width", "100000", "--height", "100000"],
         "error: --width: must be at most 65536 pixels",
     );
     // 15000² pixels with SPPM need ~144 GB: refused with the estimate.
     refused(
+        &dir,
         &["--width", "15000", "--height", "15000", "--integrator", "sppm"],
         "error: --width: a 15000×15000 image with sppm needs about 144.0 GB of memory, more than the",
     );
@@ -58,6 +61,7 @@ fn image_size_is_checked_before_allocating() {
 #[test]
 fn fifteen_thousand_squared_is_refused_where_it_cannot_fit() {
     use prism::settings::validate::{LIGHT_PATH_BYTES_PER_PIXEL, PATH_TRACING_BYTES_PER_PIXEL};
+    let dir = scratch("fifteen_thousand_squared_is_refused_where_it_cannot_fit");
     let available = prism::settings::validate::available_memory();
     for (light_paths, bytes, size) in [
         ("false", PATH_TRACING_BYTES_PER_PIXEL, "27.0 GB"),
@@ -65,6 +69,7 @@ fn fifteen_thousand_squared_is_refused_where_it_cannot_fit() {
     ] {
         match available {
             Some(available) if available < 15_000u64 * 15_000 * bytes => refused(
+                &dir,
                 &["--width", "15000", "--height", "15000", "--caustic-light-paths", light_paths],
                 &format!("error: --width: a 15000×15000 image with pt needs about {size} of memory"),
             ),
@@ -75,28 +80,54 @@ fn fifteen_thousand_squared_is_refused_where_it_cannot_fit() {
 
 #[test]
 fn thread_count_exposure_and_time_have_documented_ranges() {
-    refused(&["--threads", "0"], "error: --threads: must be between 1 and 256 (found 0)");
+    let dir = scratch("thread_count_exposure_and_time_have_documented_ranges");
     refused(
+        &dir,
+        &["--threads", "0"],
+        "error: --threads: must be between 1 and 256 (found 0)",
+    );
+    refused(
+        &dir,
         &["--threads", "10000"],
         "error: --threads: must be between 1 and 256 (found 10000)",
     );
-    refused(&["--exposure", "nan"], "error: --exposure: must be a finite number of stops");
-    refused(&["--exposure", "inf"], "error: --exposure: must be a finite number of stops");
-    refused(&["--time", "1e30"], "error: --time: must be a number of seconds above 0");
-    refused(&["--max-depth", "2147483647"], "error: --max-depth: must be at most 1024");
+    refused(
+        &dir,
+        &["--exposure", "nan"],
+        "error: --exposure: must be a finite number of stops",
+    );
+    refused(
+        &dir,
+        &["--exposure", "inf"],
+        "error: --exposure: must be a finite number of stops",
+    );
+    refused(
+        &dir,
+        &["--time", "1e30"],
+        "error: --time: must be a number of seconds above 0",
+    );
+    refused(
+        &dir,
+        &["--max-depth", "2147483647"],
+        "error: --max-depth: must be at most 1024",
+    );
 }
 
 #[test]
 fn negative_numbers_get_the_range_not_a_clap_tip() {
+    let dir = scratch("negative_numbers_get_the_range_not_a_clap_tip");
     refused(
+        &dir,
         &["--radius", "-1"],
         "error: --radius: must be between 1e-12 and 1e12 scene units (found -1)",
     );
     refused(
+        &dir,
         &["--alpha", "-0.5"],
         "error: --alpha: must be strictly between 0 and 1 (found -0.5)",
     );
     refused(
+        &dir,
         &["--adaptive-threshold", "-1"],
         "error: --adaptive-threshold: must be a positive finite number",
     );
@@ -105,16 +136,23 @@ fn negative_numbers_get_the_range_not_a_clap_tip() {
 /// `--time 5 -o missing/dir/x.png` used to render for 5 s, then fail.
 #[test]
 fn the_output_is_checked_before_rendering() {
+    let dir = scratch("the_output_is_checked_before_rendering");
     let started = Instant::now();
     refused(
+        &dir,
         &["--time", "5", "-o", "missing/dir/x.png"],
         "error: missing/dir/x.png: cannot write image: folder missing/dir does not exist",
     );
-    refused(&["--time", "5", "-o", "x.tiff"], "error: x.tiff: unsupported image format");
-    let folder = scratch("a-folder.png");
+    refused(
+        &dir,
+        &["--time", "5", "-o", "x.tiff"],
+        "error: x.tiff: unsupported image format",
+    );
+    let folder = dir.join("a-folder.png");
     std::fs::create_dir_all(&folder).expect("folder");
     let folder_text = folder.display().to_string();
     refused(
+        &dir,
         &["--time", "5", "-o", &folder_text],
         &format!("error: {folder_text}: cannot write image: is a directory"),
     );

@@ -6,7 +6,7 @@
 //! rendered it, or any rounding that depends on grouping, changes bits.
 
 mod common;
-use common::shipped_scene;
+use common::{ScratchDir, shipped_scene};
 use prism::farm::file::write_film;
 use prism::farm::{FilmHeader, MergeOptions, PartRequest, content_hash, merge_files, plan_share};
 use prism::film::Film;
@@ -16,7 +16,6 @@ use prism::sampler::SamplerKind;
 use prism::scene::LoadedScene;
 use prism::settings::RadiusSchedule;
 use std::ops::ControlFlow;
-use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 
 const PART_COUNTS: [u32; 4] = [1, 2, 3, 7];
@@ -145,14 +144,14 @@ fn film_files_merge_exactly_in_any_grouping() {
     let loaded = shipped_scene("cornell.toml");
     let settings = cornell_settings(&loaded);
     let whole = render_share(&loaded, &settings, &Share::whole(15), 2);
-    let folder = scratch("grouping");
+    let dir = ScratchDir::new("prism-farm", "film_files_merge_exactly_in_any_grouping");
     let hash = content_hash::scene_hash(&loaded.scene, &loaded.camera);
     let ranges = [9..15, 0..4, 4..9];
     let mut files = Vec::new();
     for range in ranges {
         let share = plan_share(&settings, &PartRequest::Samples(range.clone())).expect("splits");
         let film = render_share(&loaded, &settings, &share, 1);
-        let path = folder.join(format!("{}-{}.film", range.start, range.end));
+        let path = dir.join(format!("{}-{}.film", range.start, range.end));
         write_film(&path, &FilmHeader::new("cornell.toml", &settings, &hash, &share, None), &film).expect("writes");
         files.push(path);
     }
@@ -161,17 +160,10 @@ fn film_files_merge_exactly_in_any_grouping() {
     assert!(merged.missing.is_empty());
     assert_eq!(merged.samples_held, 20 * 14 * 15);
     // Two of them merged first, then with the third.
-    let pair = folder.join("pair.film");
+    let pair = dir.join("pair.film");
     let first_two = merge_files(&files[..2], MergeOptions { allow_missing: true }).expect("merges with a gap");
     assert_eq!(first_two.missing.to_string(), "samples 4..9 of every row");
     write_film(&pair, &first_two.header, &first_two.film).expect("writes");
     let again = merge_files(&[pair, files[2].clone()], MergeOptions::default()).expect("merges");
     assert!(again.film == whole, "a merge of merges differs from one run");
-    let _ = std::fs::remove_dir_all(&folder);
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let folder = std::env::temp_dir().join(format!("prism-farm-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&folder).expect("temp dir");
-    folder
 }

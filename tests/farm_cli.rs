@@ -4,26 +4,23 @@
 //! scene, other settings, overlapping parts, a gap, a truncated, corrupt or
 //! foreign file) fails with an error naming the file and writes nothing.
 
+mod common;
+use common::ScratchDir;
 use prism::output::load_frame;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
-use std::sync::OnceLock;
 
 /// Small enough for a debug build: 16×16 pixels, 6 samples, 3 parts.
 const SIZE: [&str; 6] = ["--width", "16", "--height", "16", "--spp", "6"];
 
-fn folder() -> &'static Path {
-    static FOLDER: OnceLock<PathBuf> = OnceLock::new();
-    FOLDER.get_or_init(|| {
-        let folder = std::env::temp_dir().join(format!("prism-farm-cli-{}", std::process::id()));
-        std::fs::create_dir_all(&folder).expect("temp dir");
-        folder
-    })
+/// The test's scratch directory, where `prism` runs and writes.
+fn scratch(test: &str) -> ScratchDir {
+    ScratchDir::new("prism-farm-cli", test)
 }
 
-fn prism(args: &[&str], env: &[(&str, &str)]) -> Output {
+fn prism(folder: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
     let mut command = Command::new(env!("CARGO_BIN_EXE_prism"));
-    command.args(args).current_dir(folder());
+    command.args(args).current_dir(folder);
     // The test's own environment must not choose a part.
     for name in [
         "SLURM_ARRAY_TASK_ID",
@@ -36,8 +33,8 @@ fn prism(args: &[&str], env: &[(&str, &str)]) -> Output {
     command.envs(env.iter().copied()).output().expect("run prism")
 }
 
-fn succeeds(args: &[&str], env: &[(&str, &str)]) {
-    let output = prism(args, env);
+fn succeeds(folder: &Path, args: &[&str], env: &[(&str, &str)]) {
+    let output = prism(folder, args, env);
     assert!(
         output.status.success(),
         "{args:?}: {}",
@@ -47,30 +44,26 @@ fn succeeds(args: &[&str], env: &[(&str, &str)]) {
 
 /// Renders part `part` of the default scene to `name` with `extra` flags
 /// (seed 4 unless they give one).
-fn part(name: &str, part: &str, extra: &[&str]) {
+fn part(folder: &Path, name: &str, part: &str, extra: &[&str]) {
     let mut args = vec!["render", "--quiet", "--part", part, "-o", name];
     args.extend(SIZE);
     args.extend(extra);
     if !extra.contains(&"--seed") {
         args.extend(["--seed", "4"]);
     }
-    succeeds(&args, &[]);
+    succeeds(folder, &args, &[]);
 }
 
-/// The three parts, rendered once for all tests.
-fn parts() {
-    static DONE: OnceLock<()> = OnceLock::new();
-    DONE.get_or_init(|| {
-        for k in 0..3 {
-            part(&format!("part-{k}.film"), &format!("{k}/3"), &[]);
-        }
-    });
+/// The three parts, in the test's own folder.
+fn parts(folder: &Path) {
+    for k in 0..3 {
+        part(folder, &format!("part-{k}.film"), &format!("{k}/3"), &[]);
+    }
 }
 
-/// Temporary files of outputs named `output` left in the folder (other
-/// tests write their own outputs meanwhile).
-fn leftovers(output: &str) -> Vec<String> {
-    std::fs::read_dir(folder())
+/// Temporary files of outputs named `output` left in the folder.
+fn leftovers(folder: &Path, output: &str) -> Vec<String> {
+    std::fs::read_dir(folder)
         .expect("folder")
         .flatten()
         .map(|e| e.file_name().to_string_lossy().into_owned())
@@ -80,26 +73,33 @@ fn leftovers(output: &str) -> Vec<String> {
 
 /// `prism merge inputs -o out.exr` fails with an error starting `start`,
 /// and no image (nor temporary file) is written.
-fn refused(inputs: &[&str], start: &str) {
+fn refused(folder: &Path, inputs: &[&str], start: &str) {
     let out = format!("refused-{}.exr", std::process::id());
     let mut args = vec!["merge"];
     args.extend(inputs);
     args.extend(["-o", &out]);
-    let output = prism(&args, &[]);
+    let output = prism(folder, &args, &[]);
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(!output.status.success(), "{inputs:?}: exit 0");
     assert!(stderr.starts_with(start), "{inputs:?}: expected {start:?}…, got {stderr:?}");
-    assert!(!folder().join(&out).exists(), "{inputs:?}: an image was written");
-    assert_eq!(leftovers(&out), Vec::<String>::new(), "{inputs:?}: temporary files left");
+    assert!(!folder.join(&out).exists(), "{inputs:?}: an image was written");
+    assert_eq!(
+        leftovers(folder, &out),
+        Vec::<String>::new(),
+        "{inputs:?}: temporary files left"
+    );
 }
 
 #[test]
 fn parts_from_separate_processes_merge_into_the_single_process_image() {
-    parts();
+    let dir = scratch("parts_from_separate_processes_merge_into_the_single_process_image");
+    let folder = dir.path();
+    parts(folder);
     let mut single = vec!["render", "--quiet", "--seed", "4", "-o", "single.exr"];
     single.extend(SIZE);
-    succeeds(&single, &[]);
+    succeeds(folder, &single, &[]);
     succeeds(
+        folder,
         &[
             "merge",
             "part-2.film",
@@ -111,11 +111,12 @@ fn parts_from_separate_processes_merge_into_the_single_process_image() {
         ],
         &[],
     );
-    let merged = load_frame(&folder().join("merged.exr")).expect("merged image");
-    let single = load_frame(&folder().join("single.exr")).expect("single image");
+    let merged = load_frame(&folder.join("merged.exr")).expect("merged image");
+    let single = load_frame(&folder.join("single.exr")).expect("single image");
     assert_eq!(merged.pixels, single.pixels, "merged parts differ from one process");
     // A merge to a film file, merged again, gives the same image.
     succeeds(
+        folder,
         &[
             "merge",
             "part-0.film",
@@ -126,18 +127,24 @@ fn parts_from_separate_processes_merge_into_the_single_process_image() {
         ],
         &[],
     );
-    succeeds(&["merge", "first-two.film", "part-2.film", "-o", "again.exr", "--quiet"], &[]);
-    let again = load_frame(&folder().join("again.exr")).expect("image");
+    succeeds(
+        folder,
+        &["merge", "first-two.film", "part-2.film", "-o", "again.exr", "--quiet"],
+        &[],
+    );
+    let again = load_frame(&folder.join("again.exr")).expect("image");
     assert_eq!(again.pixels, single.pixels, "a merge of merges differs");
 }
 
 #[test]
 fn part_auto_reads_slurm_and_kubernetes_variables() {
-    parts();
+    let dir = scratch("part_auto_reads_slurm_and_kubernetes_variables");
+    let folder = dir.path();
+    parts(folder);
     let mut args = vec!["render", "--quiet", "--seed", "4", "--part", "auto/3", "-o", "indexed.film"];
     args.extend(SIZE);
-    succeeds(&args, &[("JOB_COMPLETION_INDEX", "1")]);
-    let read = |name: &str| std::fs::read(folder().join(name)).expect("film file");
+    succeeds(folder, &args, &[("JOB_COMPLETION_INDEX", "1")]);
+    let read = |name: &str| std::fs::read(folder.join(name)).expect("film file");
     assert!(
         read("indexed.film") == read("part-1.film"),
         "JOB_COMPLETION_INDEX=1 is not part 1/3"
@@ -149,36 +156,42 @@ fn part_auto_reads_slurm_and_kubernetes_variables() {
         ("SLURM_ARRAY_TASK_MIN", "5"),
         ("SLURM_ARRAY_TASK_COUNT", "3"),
     ];
-    succeeds(&args, &slurm);
+    succeeds(folder, &args, &slurm);
     assert!(
         read("array.film") == read("part-2.film"),
         "array task 7 of 5..7 is not part 2/3"
     );
     // Kubernetes does not say how many parts there are.
-    let output = prism(&args, &[("JOB_COMPLETION_INDEX", "1")]);
+    let output = prism(folder, &args, &[("JOB_COMPLETION_INDEX", "1")]);
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(!output.status.success() && stderr.contains("--part auto/N"), "{stderr}");
 }
 
 #[test]
 fn bad_merges_name_the_file_and_write_nothing() {
-    parts();
+    let dir = scratch("bad_merges_name_the_file_and_write_nothing");
+    let folder = dir.path();
+    parts(folder);
     refused(
+        folder,
         &["part-0.film", "part-2.film"],
         "error: parts are missing: samples 2..4 of every row",
     );
-    std::fs::copy(folder().join("part-1.film"), folder().join("copy.film")).expect("copy");
+    std::fs::copy(folder.join("part-1.film"), folder.join("copy.film")).expect("copy");
     refused(
+        folder,
         &["part-0.film", "part-1.film", "copy.film", "part-2.film"],
         "error: copy.film: samples 2..4 of row 0 are also in part-1.film",
     );
-    part("seed.film", "1/3", &["--seed", "5"]);
+    part(folder, "seed.film", "1/3", &["--seed", "5"]);
     refused(
+        folder,
         &["part-0.film", "seed.film", "part-2.film"],
         "error: seed.film: not a part of the same image as part-0.film: seed is 4 there but 5 here",
     );
-    part("depth.film", "1/3", &["--max-depth", "3"]);
+    part(folder, "depth.film", "1/3", &["--max-depth", "3"]);
     refused(
+        folder,
         &["part-0.film", "depth.film"],
         "error: depth.film: not a part of the same image as part-0.film: max_depth is 16 there but 3 here",
     );
@@ -187,33 +200,42 @@ fn bad_merges_name_the_file_and_write_nothing() {
     let other_scene = other_scene.display().to_string();
     args.push(&other_scene);
     args.extend(SIZE);
-    succeeds(&args, &[]);
+    succeeds(folder, &args, &[]);
     refused(
+        folder,
         &["part-0.film", "scene.film", "part-2.film"],
         "error: scene.film: not a part of the same image as part-0.film: scene_hash is",
     );
 
-    let bytes = std::fs::read(folder().join("part-1.film")).expect("part");
-    std::fs::write(folder().join("short.film"), &bytes[..bytes.len() / 2]).expect("write");
+    let bytes = std::fs::read(folder.join("part-1.film")).expect("part");
+    std::fs::write(folder.join("short.film"), &bytes[..bytes.len() / 2]).expect("write");
     refused(
+        folder,
         &["part-0.film", "short.film", "part-2.film"],
         "error: short.film: truncated: it ends after",
     );
     let mut flipped = bytes.clone();
     let middle = flipped.len() * 3 / 4;
     flipped[middle] ^= 0x10;
-    std::fs::write(folder().join("flipped.film"), &flipped).expect("write");
+    std::fs::write(folder.join("flipped.film"), &flipped).expect("write");
     refused(
+        folder,
         &["part-0.film", "flipped.film", "part-2.film"],
         "error: flipped.film: corrupt: the checksum does not match",
     );
-    std::fs::write(folder().join("image.film"), b"\x89PNG\r\n\x1a\n not a film").expect("write");
-    refused(&["part-0.film", "image.film"], "error: image.film: not a Prism film file");
-    refused(&["part-0.film", "absent.film"], "error: absent.film: cannot open");
+    std::fs::write(folder.join("image.film"), b"\x89PNG\r\n\x1a\n not a film").expect("write");
+    refused(
+        folder,
+        &["part-0.film", "image.film"],
+        "error: image.film: not a Prism film file",
+    );
+    refused(folder, &["part-0.film", "absent.film"], "error: absent.film: cannot open");
 }
 
 #[test]
 fn renders_that_cannot_be_split_are_refused_before_rendering() {
+    let dir = scratch("renders_that_cannot_be_split_are_refused_before_rendering");
+    let folder = dir.path();
     let cases: [(&[&str], &str); 4] = [
         (
             &["--part", "0/2", "-o", "x.png"],
@@ -235,10 +257,10 @@ fn renders_that_cannot_be_split_are_refused_before_rendering() {
     for (flags, start) in cases {
         let mut args = vec!["render", "--quiet"];
         args.extend(flags);
-        let output = prism(&args, &[]);
+        let output = prism(folder, &args, &[]);
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert!(!output.status.success() && stderr.starts_with(start), "{flags:?}: {stderr}");
-        assert!(!folder().join("x.film").exists() && !folder().join("x.png").exists());
+        assert!(!folder.join("x.film").exists() && !folder.join("x.png").exists());
     }
-    assert_eq!(leftovers("x."), Vec::<String>::new());
+    assert_eq!(leftovers(folder, "x."), Vec::<String>::new());
 }

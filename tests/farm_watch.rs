@@ -5,7 +5,7 @@
 //! render of one process exactly.
 
 mod common;
-use common::shipped_scene;
+use common::{ScratchDir, shipped_scene};
 use prism::farm::file::write_film;
 use prism::farm::watch::FolderWatch;
 use prism::farm::{FilmHeader, PartRequest, content_hash, plan_share};
@@ -38,8 +38,8 @@ fn write_part(folder: &Path, name: &str, loaded: &LoadedScene, settings: &Render
 
 #[test]
 fn a_watched_folder_merges_parts_as_they_arrive() {
-    let folder = std::env::temp_dir().join(format!("prism-farm-watch-{}", std::process::id()));
-    std::fs::create_dir_all(&folder).expect("temp dir");
+    let dir = ScratchDir::new("prism-farm-watch", "a_watched_folder_merges_parts_as_they_arrive");
+    let folder = dir.path();
     let loaded = shipped_scene("cornell.toml");
     let settings = RenderSettings {
         width: 12,
@@ -48,11 +48,11 @@ fn a_watched_folder_merges_parts_as_they_arrive() {
         seed: 3,
         ..loaded.settings.clone()
     };
-    let mut watch = FolderWatch::new(&folder);
+    let mut watch = FolderWatch::new(folder);
     assert!(!watch.scan().expect("lists"));
     assert_eq!((watch.status().parts, watch.frame()), (0, None));
 
-    write_part(&folder, "part-0.film", &loaded, &settings, 0);
+    write_part(folder, "part-0.film", &loaded, &settings, 0);
     std::fs::write(folder.join(".part-1.film.123.tmp"), b"being written").expect("write");
     assert!(watch.scan().expect("lists"));
     let status = watch.status();
@@ -72,7 +72,7 @@ fn a_watched_folder_merges_parts_as_they_arrive() {
         seed: 4,
         ..settings.clone()
     };
-    write_part(&folder, "other-seed.film", &loaded, &other, 1);
+    write_part(folder, "other-seed.film", &loaded, &other, 1);
     std::fs::write(folder.join("junk.film"), b"PRISMFLM").expect("write");
     watch.scan().expect("lists");
     let problems = watch.status().problems;
@@ -86,8 +86,8 @@ fn a_watched_folder_merges_parts_as_they_arrive() {
     std::fs::remove_file(folder.join("other-seed.film")).expect("remove");
     std::fs::remove_file(folder.join("junk.film")).expect("remove");
 
-    write_part(&folder, "part-1.film", &loaded, &settings, 1);
-    write_part(&folder, "part-2.film", &loaded, &settings, 2);
+    write_part(folder, "part-1.film", &loaded, &settings, 1);
+    write_part(folder, "part-2.film", &loaded, &settings, 2);
     assert!(watch.scan().expect("lists"));
     let status = watch.status();
     assert_eq!((status.parts, status.samples_held), (3, 12 * 10 * 9));
@@ -100,8 +100,7 @@ fn a_watched_folder_merges_parts_as_they_arrive() {
     std::fs::remove_file(folder.join("part-1.film")).expect("remove");
     assert!(watch.scan().expect("lists"));
     assert_eq!(watch.status().parts, 2);
-    write_part(&folder, "part-1.film", &loaded, &settings, 1);
+    write_part(folder, "part-1.film", &loaded, &settings, 1);
     watch.scan().expect("lists");
     assert!(watch.film() == Some(&whole));
-    let _ = std::fs::remove_dir_all(&folder);
 }

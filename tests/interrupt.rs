@@ -3,14 +3,15 @@
 //! with its real pass count in the metadata; a second one exits at once and
 //! leaves no file behind.
 
-use std::path::{Path, PathBuf};
+mod common;
+use common::ScratchDir;
+use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("prism-interrupt-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
+/// The test's scratch directory, for the render's image.
+fn scratch(test: &str) -> ScratchDir {
+    ScratchDir::new("prism-interrupt", test)
 }
 
 /// Starts a long render of the default scene into `dir/out.png`.
@@ -87,13 +88,14 @@ fn png_text(path: &Path) -> Vec<(String, String)> {
 
 #[test]
 fn a_first_sigint_saves_the_passes_so_far() {
-    let dir = scratch("int");
-    let child = start(&dir, "48");
-    wait_until_rendering(&dir, Duration::from_millis(1500));
+    let scratch_dir = scratch("a_first_sigint_saves_the_passes_so_far");
+    let dir = scratch_dir.path();
+    let child = start(dir, "48");
+    wait_until_rendering(dir, Duration::from_millis(1500));
     kill(&child, "-INT");
     let (code, stderr) = finish(child);
     assert_eq!(code, Some(130), "{stderr}");
-    assert_eq!(files(&dir), vec!["out.png".to_string()], "{stderr}");
+    assert_eq!(files(dir), vec!["out.png".to_string()], "{stderr}");
     let text = png_text(&dir.join("out.png"));
     let passes: u32 = text
         .iter()
@@ -113,13 +115,14 @@ fn a_first_sigint_saves_the_passes_so_far() {
 
 #[test]
 fn a_first_sigterm_saves_too() {
-    let dir = scratch("term");
-    let child = start(&dir, "48");
-    wait_until_rendering(&dir, Duration::from_millis(1500));
+    let scratch_dir = scratch("a_first_sigterm_saves_too");
+    let dir = scratch_dir.path();
+    let child = start(dir, "48");
+    wait_until_rendering(dir, Duration::from_millis(1500));
     kill(&child, "-TERM");
     let (code, stderr) = finish(child);
     assert_eq!(code, Some(143), "{stderr}");
-    assert_eq!(files(&dir), vec!["out.png".to_string()], "{stderr}");
+    assert_eq!(files(dir), vec!["out.png".to_string()], "{stderr}");
     assert!(png_text(&dir.join("out.png")).contains(&("Interrupted".into(), "SIGTERM".into())));
 }
 
@@ -127,9 +130,10 @@ fn a_first_sigterm_saves_too() {
 /// flight: the process ends at once, without an image or a temporary file.
 #[test]
 fn a_second_signal_exits_at_once_leaving_nothing() {
-    let dir = scratch("twice");
-    let child = start(&dir, "1200");
-    wait_until_rendering(&dir, Duration::from_millis(300));
+    let scratch_dir = scratch("a_second_signal_exits_at_once_leaving_nothing");
+    let dir = scratch_dir.path();
+    let child = start(dir, "1200");
+    wait_until_rendering(dir, Duration::from_millis(300));
     kill(&child, "-INT");
     std::thread::sleep(Duration::from_millis(300));
     let sent = Instant::now();
@@ -138,5 +142,5 @@ fn a_second_signal_exits_at_once_leaving_nothing() {
     assert!(sent.elapsed() < Duration::from_secs(2), "took {:?} to exit", sent.elapsed());
     assert_eq!(code, Some(130), "{stderr}");
     assert!(stderr.contains("quitting without saving"), "{stderr}");
-    assert_eq!(files(&dir), Vec::<String>::new(), "{stderr}");
+    assert_eq!(files(dir), Vec::<String>::new(), "{stderr}");
 }

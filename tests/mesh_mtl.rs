@@ -3,16 +3,17 @@
 //! with a warning naming every key that is ignored; the scene's own material
 //! wins over the library.
 
+mod common;
+use common::ScratchDir;
 use glam::DVec3;
 use prism::material::Material;
 use prism::material::texture::Texture;
 use prism::scene::{LoadedScene, load_scene_str};
 use std::path::{Path, PathBuf};
 
-fn folder() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("prism-mtl-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
+/// The test's scratch directory, for its OBJ, MTL and image files.
+fn scratch(test: &str) -> ScratchDir {
+    ScratchDir::new("prism-mtl", test)
 }
 
 /// Five triangles in groups using materials `lamp`, `water`, `chrome`,
@@ -77,8 +78,8 @@ fn material_of_face(loaded: &LoadedScene, face: u32) -> &Material {
 
 #[test]
 fn mtl_materials_map_onto_prism_materials() {
-    let dir = folder();
-    let obj = write_obj(&dir);
+    let dir = scratch("mtl_materials_map_onto_prism_materials");
+    let obj = write_obj(dir.path());
     let loaded = scene_with_mesh(&obj, None).expect("loads");
     match material_of_face(&loaded, 0) {
         Material::Emissive {
@@ -140,7 +141,8 @@ fn mtl_materials_map_onto_prism_materials() {
 
 #[test]
 fn the_scene_material_wins_with_a_warning() {
-    let obj = write_obj(&folder());
+    let dir = scratch("the_scene_material_wins_with_a_warning");
+    let obj = write_obj(dir.path());
     let loaded = scene_with_mesh(&obj, Some("white")).expect("loads");
     for face in 0..5 {
         assert!(matches!(material_of_face(&loaded, face), Material::Diffuse { .. }));
@@ -156,7 +158,7 @@ fn the_scene_material_wins_with_a_warning() {
 
 #[test]
 fn a_mesh_without_materials_needs_a_scene_material() {
-    let dir = folder();
+    let dir = scratch("a_mesh_without_materials_needs_a_scene_material");
     let plain = dir.join("plain.obj");
     std::fs::write(&plain, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").expect("obj");
     let error = scene_with_mesh(&plain, None).err().unwrap_or_default();

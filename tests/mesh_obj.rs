@@ -1,12 +1,17 @@
 //! OBJ meshes: vertex normals (smooth shading), uv, transforms, and errors.
 
+mod common;
+use common::ScratchDir;
 use glam::{DVec2, DVec3};
 use prism::geometry::{Mesh, Shape, Transform};
 use prism::math::Ray;
 
-fn write_obj(name: &str, text: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("prism-mesh-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
+/// The test's scratch directory, for its OBJ files.
+fn scratch(test: &str) -> ScratchDir {
+    ScratchDir::new("prism-mesh", test)
+}
+
+fn write_obj(dir: &ScratchDir, name: &str, text: &str) -> std::path::PathBuf {
     let path = dir.join(name);
     std::fs::write(&path, text).expect("write obj");
     path
@@ -18,7 +23,8 @@ const SQUARE: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1
 
 #[test]
 fn normals_uv_and_transform_are_applied() {
-    let path = write_obj("square.obj", SQUARE);
+    let dir = scratch("normals_uv_and_transform_are_applied");
+    let path = write_obj(&dir, "square.obj", SQUARE);
     let transform = Transform::new(DVec3::new(10.0, 0.0, 0.0), DVec3::ZERO, DVec3::splat(2.0));
     let mesh = Mesh::load_obj(&path, &transform).expect("load");
     assert_eq!(mesh.faces.len(), 2);
@@ -43,8 +49,9 @@ fn normals_uv_and_transform_are_applied() {
 
 #[test]
 fn broken_obj_is_an_error_not_a_panic() {
-    let path = write_obj("broken.obj", "v 0 0 0\nv 1 0 0\nf 1 2 7\n");
+    let dir = scratch("broken_obj_is_an_error_not_a_panic");
+    let path = write_obj(&dir, "broken.obj", "v 0 0 0\nv 1 0 0\nf 1 2 7\n");
     assert!(Mesh::load_obj(&path, &Transform::default()).is_err());
-    let empty = write_obj("empty.obj", "# nothing\n");
+    let empty = write_obj(&dir, "empty.obj", "# nothing\n");
     assert!(Mesh::load_obj(&empty, &Transform::default()).is_err());
 }

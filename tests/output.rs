@@ -1,5 +1,7 @@
 //! Image files: every format round-trips, metadata is recorded, and writes are atomic.
 
+mod common;
+use common::ScratchDir;
 use prism::film::{Frame, ToneMap};
 use prism::output::{load_frame, save_frame};
 
@@ -19,10 +21,9 @@ fn frame() -> Frame {
     }
 }
 
-fn dir() -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("prism-output-{}", std::process::id()));
-    std::fs::create_dir_all(&d).expect("temp dir");
-    d
+/// The test's scratch directory, for the images it writes.
+fn scratch(test: &str) -> ScratchDir {
+    ScratchDir::new("prism-output", test)
 }
 
 fn metadata() -> Vec<(String, String)> {
@@ -31,7 +32,8 @@ fn metadata() -> Vec<(String, String)> {
 
 #[test]
 fn exr_is_linear_and_carries_metadata() {
-    let path = dir().join("a.exr");
+    let dir = scratch("exr_is_linear_and_carries_metadata");
+    let path = dir.join("a.exr");
     save_frame(&frame(), &path, 0.0, ToneMap::Clamp, &metadata()).expect("save");
     let back = load_frame(&path).expect("load");
     assert_eq!(back.pixels, frame().pixels, "EXR stores linear f32 exactly");
@@ -42,8 +44,9 @@ fn exr_is_linear_and_carries_metadata() {
 
 #[test]
 fn png_bmp_ppm_round_trip_within_8_bit_quantisation() {
+    let dir = scratch("png_bmp_ppm_round_trip_within_8_bit_quantisation");
     for extension in ["png", "bmp", "ppm"] {
-        let path = dir().join(format!("b.{extension}"));
+        let path = dir.join(format!("b.{extension}"));
         save_frame(&frame(), &path, 0.0, ToneMap::Clamp, &metadata()).expect("save");
         let back = load_frame(&path).expect("load");
         for (a, b) in frame().pixels.iter().zip(&back.pixels) {
@@ -53,7 +56,7 @@ fn png_bmp_ppm_round_trip_within_8_bit_quantisation() {
             }
         }
     }
-    let png = std::fs::read(dir().join("b.png")).expect("read");
+    let png = std::fs::read(dir.join("b.png")).expect("read");
     let needle = b"scenes/cornell.toml";
     assert!(
         png.windows(needle.len()).any(|w| w == needle),
@@ -63,7 +66,8 @@ fn png_bmp_ppm_round_trip_within_8_bit_quantisation() {
 
 #[test]
 fn failed_write_leaves_nothing_behind() {
-    let folder = dir().join("atomic");
+    let dir = scratch("failed_write_leaves_nothing_behind");
+    let folder = dir.join("atomic");
     std::fs::create_dir_all(&folder).expect("dir");
     // A directory where the image should go makes the final rename fail.
     let target = folder.join("c.png");

@@ -2,6 +2,8 @@
 //! field path, a non-zero exit code, no panic and no image. One test per
 //! category of error, each asserting the exact location and path.
 
+mod common;
+use common::ScratchDir;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -22,14 +24,13 @@ fn sphere_scene(from: &str, to: &str) -> String {
     format!("{GOOD}\n{}", sphere.replace(from, to))
 }
 
-fn scratch_dir() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("prism-scene-errors-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
+/// The test's scratch directory, for its scenes and meshes.
+fn scratch(test: &str) -> ScratchDir {
+    ScratchDir::new("prism-scene-errors", test)
 }
 
-fn write_scene(name: &str, text: impl AsRef<[u8]>) -> PathBuf {
-    let path = scratch_dir().join(name);
+fn write_scene(dir: &ScratchDir, name: &str, text: impl AsRef<[u8]>) -> PathBuf {
+    let path = dir.join(name);
     std::fs::write(&path, text).expect("write scene");
     path
 }
@@ -51,8 +52,8 @@ fn run_with(path: &Path, args: &[&str]) -> (bool, String) {
 /// The error for `text` is exactly `file:line:column: field: message...`
 /// (`field` empty when the error has none), on one line, with `words` in
 /// the message.
-fn check(name: &str, text: impl AsRef<[u8]>, line: usize, column: usize, field: &str, words: &str) {
-    let path = write_scene(name, text);
+fn check(dir: &ScratchDir, name: &str, text: impl AsRef<[u8]>, line: usize, column: usize, field: &str, words: &str) {
+    let path = write_scene(dir, name, text);
     let (success, stderr) = run_with(&path, &[]);
     assert!(!success, "{name}: exit code was 0");
     assert!(!stderr.contains("panicked"), "{name}: panicked: {stderr}");
@@ -74,13 +75,15 @@ fn check(name: &str, text: impl AsRef<[u8]>, line: usize, column: usize, field: 
 
 #[test]
 fn syntax_error() {
+    let dir = scratch("syntax_error");
     let text = sphere_scene("center = [0, 0, 0]", "center = [0, 0, 0");
     // The parser notices the unclosed array where the next line begins.
-    check("syntax.toml", text, 12, 1, "objects[0].center", "expected `,`");
+    check(&dir, "syntax.toml", text, 12, 1, "objects[0].center", "expected `,`");
 }
 
 #[test]
 fn type_error_inside_an_object_is_placed_at_the_value() {
+    let dir = scratch("type_error_inside_an_object_is_placed_at_the_value");
     // Not at the first [[objects]] header: the value itself, with its index.
     let text = format!(
         "{}{}",
@@ -88,6 +91,7 @@ fn type_error_inside_an_object_is_placed_at_the_value() {
         "\n[[objects]]\ntype = \"sphere\"\ncenter = [0, \"up\", 0]\nradius = 1\nmaterial = \"white\"\n"
     );
     check(
+        &dir,
         "type.toml",
         text,
         17,
@@ -99,17 +103,20 @@ fn type_error_inside_an_object_is_placed_at_the_value() {
 
 #[test]
 fn unknown_key() {
+    let dir = scratch("unknown_key");
     let text = sphere_scene("material = \"white\"", "material = \"white\"\ncolour = [1, 0, 0]");
-    check("field.toml", text, 14, 1, "objects[0].colour", "colour");
+    check(&dir, "field.toml", text, 14, 1, "objects[0].colour", "colour");
 }
 
 #[test]
 fn unknown_key_in_a_texture_table() {
+    let dir = scratch("unknown_key_in_a_texture_table");
     let text = GOOD.replace(
         "albedo = [0.5, 0.5, 0.5]",
         "albedo = { checker = [[0, 0, 0], [1, 1, 1]], scael = 2 }",
     );
     check(
+        &dir,
         "texture.toml",
         text,
         7,
@@ -121,10 +128,20 @@ fn unknown_key_in_a_texture_table() {
 
 #[test]
 fn missing_key_names_the_table_it_is_missing_from() {
+    let dir = scratch("missing_key_names_the_table_it_is_missing_from");
     let text = GOOD.replace("position = [0, 0, 5]\n", "");
-    check("missing.toml", text, 1, 1, "camera.position", "missing field `position`");
+    check(
+        &dir,
+        "missing.toml",
+        text,
+        1,
+        1,
+        "camera.position",
+        "missing field `position`",
+    );
     let text = sphere_scene("radius = 1\n", "");
     check(
+        &dir,
         "missing-radius.toml",
         text,
         9,
@@ -136,14 +153,17 @@ fn missing_key_names_the_table_it_is_missing_from() {
 
 #[test]
 fn unknown_kind_names_the_type_key() {
+    let dir = scratch("unknown_kind_names_the_type_key");
     let text = sphere_scene("type = \"sphere\"", "type = \"spehre\"");
-    check("kind.toml", text, 10, 8, "objects[0].type", "unknown variant `spehre`");
+    check(&dir, "kind.toml", text, 10, 8, "objects[0].type", "unknown variant `spehre`");
 }
 
 #[test]
 fn range_error() {
+    let dir = scratch("range_error");
     let text = sphere_scene("radius = 1", "radius = -2");
     check(
+        &dir,
         "radius.toml",
         text,
         12,
@@ -152,7 +172,7 @@ fn range_error() {
         "must be positive (found -2)",
     );
     let text = GOOD.replace("type = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]", "type = \"glass\"\nior = -1.5");
-    check("ior.toml", text, 7, 7, "materials.white.ior", "must be positive");
+    check(&dir, "ior.toml", text, 7, 7, "materials.white.ior", "must be positive");
 }
 
 /// An emissive material gives an RGB `radiance`, or a `spectrum` or
@@ -160,6 +180,7 @@ fn range_error() {
 /// placed at the key that is wrong.
 #[test]
 fn spectral_light_errors_name_the_key() {
+    let dir = scratch("spectral_light_errors_name_the_key");
     let light = |keys: &str| {
         GOOD.replace(
             "type = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]",
@@ -167,6 +188,7 @@ fn spectral_light_errors_name_the_key() {
         )
     };
     check(
+        &dir,
         "cold.toml",
         light("temperature = 100\nluminance = 1"),
         7,
@@ -175,6 +197,7 @@ fn spectral_light_errors_name_the_key() {
         "must be between 500 and 1000000 kelvin (found 100)",
     );
     check(
+        &dir,
         "d50.toml",
         light("spectrum = \"D50\"\nluminance = 1"),
         7,
@@ -183,6 +206,7 @@ fn spectral_light_errors_name_the_key() {
         "unknown illuminant \"D50\" (known: D65, A)",
     );
     check(
+        &dir,
         "dark.toml",
         light("spectrum = \"A\"\nluminance = -1"),
         8,
@@ -191,6 +215,7 @@ fn spectral_light_errors_name_the_key() {
         "must not be negative (found -1)",
     );
     check(
+        &dir,
         "both.toml",
         light("spectrum = \"A\"\ntemperature = 2000\nluminance = 1"),
         8,
@@ -199,6 +224,7 @@ fn spectral_light_errors_name_the_key() {
         "not both",
     );
     check(
+        &dir,
         "scaled-rgb.toml",
         light("radiance = [1, 1, 1]\nluminance = 2"),
         8,
@@ -207,6 +233,7 @@ fn spectral_light_errors_name_the_key() {
         "an RGB `radiance` is its own scale",
     );
     check(
+        &dir,
         "rgb-and-spectrum.toml",
         light("radiance = [1, 1, 1]\nspectrum = \"D65\"\nluminance = 2"),
         7,
@@ -215,6 +242,7 @@ fn spectral_light_errors_name_the_key() {
         "not both",
     );
     check(
+        &dir,
         "unscaled.toml",
         light("temperature = 2700"),
         5,
@@ -223,6 +251,7 @@ fn spectral_light_errors_name_the_key() {
         "missing field `luminance`",
     );
     check(
+        &dir,
         "nothing.toml",
         light("two_sided = true"),
         5,
@@ -234,8 +263,10 @@ fn spectral_light_errors_name_the_key() {
 
 #[test]
 fn reference_error() {
+    let dir = scratch("reference_error");
     let text = sphere_scene("material = \"white\"", "material = \"chrome\"");
     check(
+        &dir,
         "material.toml",
         text,
         13,
@@ -247,50 +278,64 @@ fn reference_error() {
 
 #[test]
 fn invalid_utf8_is_placed_at_the_first_bad_byte() {
+    let dir = scratch("invalid_utf8_is_placed_at_the_first_bad_byte");
     let mut text = GOOD.as_bytes().to_vec();
     // Line 5 is `[materials.white]`: a Latin-1 é after "[materials.wh".
     let at = GOOD.find("ite]").expect("marker");
     text[at] = 0xE9;
-    check("latin1.toml", text, 5, 14, "", "not valid UTF-8 (byte 0xe9)");
+    check(&dir, "latin1.toml", text, 5, 14, "", "not valid UTF-8 (byte 0xe9)");
 }
 
 #[test]
 fn nan_value() {
+    let dir = scratch("nan_value");
     let text = sphere_scene("center = [0, 0, 0]", "center = [0, nan, 0]");
-    check("nan.toml", text, 11, 14, "objects[0].center[1]", "finite");
+    check(&dir, "nan.toml", text, 11, 14, "objects[0].center[1]", "finite");
 }
 
 #[test]
 fn coordinates_beyond_the_documented_range() {
+    let dir = scratch("coordinates_beyond_the_documented_range");
     let text = sphere_scene("center = [0, 0, 0]", "center = [0, 0, 2e12]");
-    check("far.toml", text, 11, 17, "objects[0].center[2]", "within ±1e12");
+    check(&dir, "far.toml", text, 11, 17, "objects[0].center[2]", "within ±1e12");
     let text = GOOD.replace("position = [0, 0, 5]", "position = [0, 0, 1e308]");
-    check("camera-far.toml", text, 2, 19, "camera.position[2]", "within ±1e12");
+    check(&dir, "camera-far.toml", text, 2, 19, "camera.position[2]", "within ±1e12");
 }
 
 #[test]
 fn missing_mesh_file() {
+    let dir = scratch("missing_mesh_file");
     let text = sphere_scene(
         "type = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1",
         "type = \"mesh\"\nfile = \"no-such-bunny.obj\"",
     );
-    check("mesh.toml", text, 11, 8, "objects[0].file", "no-such-bunny.obj: no such file");
+    check(
+        &dir,
+        "mesh.toml",
+        text,
+        11,
+        8,
+        "objects[0].file",
+        "no-such-bunny.obj: no such file",
+    );
 }
 
 #[test]
 fn a_mesh_path_that_is_a_directory_or_a_device_says_so() {
-    let folder = scratch_dir().join("a-folder.obj");
+    let dir = scratch("a_mesh_path_that_is_a_directory_or_a_device_says_so");
+    let folder = dir.join("a-folder.obj");
     std::fs::create_dir_all(&folder).expect("folder");
     let text = sphere_scene(
         "type = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1",
         &format!("type = \"mesh\"\nfile = {:?}", folder.display().to_string()),
     );
-    check("mesh-folder.toml", text, 11, 8, "objects[0].file", "is a directory");
+    check(&dir, "mesh-folder.toml", text, 11, 8, "objects[0].file", "is a directory");
     let text = sphere_scene(
         "type = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1",
         "type = \"mesh\"\nfile = \"/dev/zero\"",
     );
     check(
+        &dir,
         "mesh-zero.toml",
         text,
         11,
@@ -300,6 +345,7 @@ fn a_mesh_path_that_is_a_directory_or_a_device_says_so() {
     );
     let text = GOOD.replace("albedo = [0.5, 0.5, 0.5]", "albedo = { image = \"/dev/zero\" }");
     check(
+        &dir,
         "image-zero.toml",
         text,
         7,
@@ -311,7 +357,8 @@ fn a_mesh_path_that_is_a_directory_or_a_device_says_so() {
 
 #[test]
 fn nan_vertex_normals_are_refused() {
-    let obj = scratch_dir().join("nan-normal.obj");
+    let dir = scratch("nan_vertex_normals_are_refused");
+    let obj = dir.join("nan-normal.obj");
     std::fs::write(
         &obj,
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn nan 0 1\nvn 0 0 1\nf 1//1 2//2 3//3\n",
@@ -322,6 +369,7 @@ fn nan_vertex_normals_are_refused() {
         &format!("type = \"mesh\"\nfile = {:?}", obj.display().to_string()),
     );
     check(
+        &dir,
         "nan-normal.toml",
         text,
         11,
@@ -333,7 +381,8 @@ fn nan_vertex_normals_are_refused() {
 
 #[test]
 fn mesh_vertices_are_checked_after_the_transform() {
-    let obj = scratch_dir().join("unit.obj");
+    let dir = scratch("mesh_vertices_are_checked_after_the_transform");
+    let obj = dir.join("unit.obj");
     std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").expect("obj");
     let text = sphere_scene(
         "type = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1",
@@ -343,6 +392,7 @@ fn mesh_vertices_are_checked_after_the_transform() {
         ),
     );
     check(
+        &dir,
         "mesh-far.toml",
         text,
         12,
@@ -354,8 +404,10 @@ fn mesh_vertices_are_checked_after_the_transform() {
 
 #[test]
 fn render_settings_in_the_file_are_checked_like_the_flags() {
+    let dir = scratch("render_settings_in_the_file_are_checked_like_the_flags");
     let text = format!("{GOOD}\n[render]\nmax_depth = 2147483647\n");
     check(
+        &dir,
         "depth.toml",
         text,
         10,
@@ -364,9 +416,10 @@ fn render_settings_in_the_file_are_checked_like_the_flags() {
         "must be at most 1024 (found 2147483647)",
     );
     let text = format!("{GOOD}\n[render]\nwidth = 100000\nheight = 100000\n");
-    check("huge.toml", text, 10, 9, "render.width", "must be at most 65536 pixels");
+    check(&dir, "huge.toml", text, 10, 9, "render.width", "must be at most 65536 pixels");
     let text = format!("{GOOD}\n[render]\nwidth = 60000\nheight = 60000\n");
     check(
+        &dir,
         "too-much-memory.toml",
         text,
         10,

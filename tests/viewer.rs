@@ -9,6 +9,8 @@
 //! The renders run at 1/8 of the default scene's resolution (64 × 64) on one
 //! worker thread, so each test takes a few seconds in a debug build.
 
+mod common;
+use common::ScratchDir;
 use egui::accesskit::Role;
 use egui::{Event, Modifiers, PointerButton, Pos2, Vec2};
 use egui_kittest::Harness;
@@ -50,8 +52,9 @@ fn step_until(harness: &mut Harness<'static, ViewerApp>, what: &str, done: impl 
     }
 }
 
-fn temporary_path(name: &str) -> PathBuf {
-    std::env::temp_dir().join(format!("prism-viewer-test-{}-{name}", std::process::id()))
+/// The test's scratch directory, for the files it writes.
+fn scratch(test: &str) -> ScratchDir {
+    ScratchDir::new("prism-viewer-test", test)
 }
 
 fn press(harness: &Harness<'static, ViewerApp>, position: Pos2, pressed: bool) {
@@ -193,8 +196,8 @@ fn save_writes_a_valid_image_with_metadata() {
         app.render_stats().state == SessionState::Paused
     });
     harness.step();
-    let path = temporary_path("snapshot.png");
-    let _ = std::fs::remove_file(&path);
+    let dir = scratch("save_writes_a_valid_image_with_metadata");
+    let path = dir.join("snapshot.png");
 
     // The path field (the fallback when no file dialog can open), then Save.
     let field = harness.get_by_role_and_label(Role::TextInput, "Snapshot path");
@@ -239,12 +242,12 @@ fn save_writes_a_valid_image_with_metadata() {
         "{text:?}"
     );
     assert!(value("Render time").is_some(), "{text:?}");
-    let _ = std::fs::remove_file(&path);
 }
 
 #[test]
 fn broken_scene_shows_its_error_in_the_window() {
-    let path = temporary_path("broken.toml");
+    let dir = scratch("broken_scene_shows_its_error_in_the_window");
+    let path = dir.join("broken.toml");
     std::fs::write(
         &path,
         "[camera]\nposition = [0, 0, 5]\nlook_at = [0, 0, 0]\nfov_y_degrees = \"wide\"\n",
@@ -268,7 +271,6 @@ fn broken_scene_shows_its_error_in_the_window() {
         "the error is shown in the window"
     );
     assert!(harness.state().displayed_frame().is_none());
-    let _ = std::fs::remove_file(&path);
 }
 
 #[test]

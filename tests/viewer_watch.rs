@@ -2,6 +2,8 @@
 //! shows the merge of a folder's film files as they arrive, with the parts,
 //! samples and what is missing in its status line.
 
+mod common;
+use common::ScratchDir;
 use egui::Vec2;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
@@ -46,8 +48,9 @@ fn step_until(harness: &mut Harness<'static, WatchApp>, what: &str, done: impl F
 
 #[test]
 fn the_watch_window_shows_parts_as_they_arrive() {
-    let folder = std::env::temp_dir().join(format!("prism-viewer-watch-{}", std::process::id()));
-    std::fs::create_dir_all(&folder).expect("temp dir");
+    // Declared first, so removed last: after the window and its scanning thread.
+    let dir = ScratchDir::new("prism-viewer-watch", "the_watch_window_shows_parts_as_they_arrive");
+    let folder = dir.path();
     let loaded = load_scene_str(DEFAULT_SCENE, Path::new("cornell"), Path::new(".")).expect("scene");
     let settings = RenderSettings {
         width: 16,
@@ -55,21 +58,21 @@ fn the_watch_window_shows_parts_as_they_arrive() {
         samples_per_pixel: Some(4),
         ..loaded.settings.clone()
     };
-    let app = WatchApp::new(&egui::Context::default(), folder.clone()).expect("scanning thread");
+    let app = WatchApp::new(&egui::Context::default(), folder.to_path_buf()).expect("scanning thread");
     let mut harness = Harness::builder()
         .with_size(Vec2::new(800.0, 600.0))
         .build_ui_state(|ui, app: &mut WatchApp| app.show(ui), app);
     harness.step();
     harness.get_by_label_contains("Waiting for film files");
 
-    write_part(&folder, &loaded, &settings, 0);
+    write_part(folder, &loaded, &settings, 0);
     step_until(&mut harness, "the first part", |app| app.status().parts == 1);
     harness.step();
     harness.get_by_label_contains("1 parts merged, 384 of 768 samples (50.0%)");
     harness.get_by_label_contains("Still missing: samples 2..4 of every row");
     assert_eq!(harness.state().frame().map(|f| (f.width, f.height)), Some((16, 12)));
 
-    write_part(&folder, &loaded, &settings, 1);
+    write_part(folder, &loaded, &settings, 1);
     step_until(&mut harness, "the second part", |app| app.status().parts == 2);
     harness.step();
     harness.get_by_label_contains("2 parts merged, 768 of 768 samples (100.0%), noise");
@@ -80,6 +83,4 @@ fn the_watch_window_shows_parts_as_they_arrive() {
         ControlFlow::Continue(())
     });
     assert_eq!(harness.state().frame(), Some(&whole.integrator().frame()));
-    drop(harness);
-    let _ = std::fs::remove_dir_all(&folder);
 }

@@ -5,7 +5,39 @@ use prism::film::Frame;
 use prism::render::{IntegratorKind, RenderSettings, render_with_threads};
 use prism::sampler::SamplerKind;
 use prism::scene::{LoadedScene, load_scene_str};
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+/// A test's own scratch directory in the system temp dir, removed with all
+/// it holds when dropped, so also when the test panics. One per test: the
+/// tests of a file run in parallel threads, and a directory they shared
+/// would be removed by whichever finished first.
+pub struct ScratchDir(PathBuf);
+
+impl ScratchDir {
+    /// `<temp dir>/<prefix>-<process id>-<test>`, empty: the process id
+    /// keeps concurrent runs apart, the test's name the tests of one run.
+    pub fn new(prefix: &str, test: &str) -> Self {
+        let path = std::env::temp_dir().join(format!("{prefix}-{}-{test}", std::process::id()));
+        // A killed run of a process with the same id may have left it.
+        let _ = std::fs::remove_dir_all(&path);
+        std::fs::create_dir_all(&path).expect("scratch directory");
+        Self(path)
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.0
+    }
+
+    pub fn join(&self, name: impl AsRef<Path>) -> PathBuf {
+        self.0.join(name)
+    }
+}
+
+impl Drop for ScratchDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
 
 pub fn scene(text: &str) -> LoadedScene {
     match load_scene_str(text, Path::new("test.toml"), Path::new(env!("CARGO_MANIFEST_DIR"))) {
