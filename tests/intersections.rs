@@ -283,3 +283,49 @@ fn skipping_the_quad_a_ray_leaves_changes_no_answer() {
     );
     assert!(to_quad_lights > 10_000, "{to_quad_lights} shadow rays to the quad light");
 }
+
+/// `Scene::nearest_distance` (the query without the hit record) finds what
+/// `Scene::intersect` finds, bit for bit: the same distance and primitive
+/// on shipped scenes holding every kind of shape (a mesh, quads, spheres,
+/// boxes, single triangles, surfaces of revolution), for rays from points
+/// between the camera and the scene's middle, in random directions.
+#[test]
+fn nearest_distance_agrees_with_intersect_on_every_shape() {
+    let mut next = uniform_stream();
+    for name in [
+        "bunny.toml",
+        "illuminants.toml",
+        "smallpt.toml",
+        "vase.toml",
+        "prism.toml",
+        "cornell.toml",
+    ] {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(name);
+        let loaded = prism::scene::load_scene_file(&path).unwrap_or_else(|e| panic!("{e}"));
+        let scene = &loaded.scene;
+        let bounds = scene.bounds();
+        let middle = bounds.min.lerp(bounds.max, 0.5);
+        let (mut hits, mut rays) = (0, 0);
+        for _ in 0..20_000 {
+            // Between the camera and the middle of the scene's bounds, so
+            // rays start inside and outside the objects.
+            let origin = loaded.camera.position.lerp(middle, next());
+            let direction = DVec3::new(2.0 * next() - 1.0, 2.0 * next() - 1.0, 2.0 * next() - 1.0);
+            if direction.length_squared() < 1e-6 {
+                continue;
+            }
+            let ray = Ray::new(origin, direction);
+            let full = scene.intersect(&ray, f64::INFINITY);
+            let distance = scene.nearest_distance(&ray, f64::INFINITY);
+            assert_eq!(
+                full.map(|found| (found.hit.t.to_bits(), found.primitive)),
+                distance.map(|(t, primitive)| (t.to_bits(), primitive)),
+                "{name}: ray from {origin} along {direction}"
+            );
+            hits += usize::from(full.is_some());
+            rays += 1;
+        }
+        // Enough rays must hit something for the comparison to say much.
+        assert!(hits >= 2_000, "{name}: only {hits} of {rays} rays hit");
+    }
+}

@@ -1,13 +1,19 @@
 //! `prism bench --rays`: the ray core measured on its own, the way ray
 //! tracing kernels are compared (Embree, tinybvh): the Stanford bunny, the
 //! bunny subdivided twice (each triangle split in four at its edge
-//! midpoints, ×16) and four times (×256); three kinds of query:
+//! midpoints, ×16) and four times (×256); two sets of rays:
 //!
 //! - *primary*: a pinhole image of the mesh, 1024 × 1024 rays in scanline
 //!   order (coherent: neighbours visit the same nodes);
 //! - *incoherent*: origins uniform on the bounding sphere, aimed at uniform
 //!   points inside the bounding box (every ray goes its own way);
-//! - *occlusion*: any-hit queries on the incoherent rays.
+//!
+//! and three queries: *closest* (`Scene::intersect`, the nearest hit and
+//! its hit record, as the renderer asks), *distance*
+//! (`Scene::nearest_distance`, the nearest hit's distance and primitive
+//! alone: the work of a kernel's closest-hit query such as Embree's
+//! `rtcIntersect1`) on both sets, and *occlusion* (any hit) on the
+//! incoherent rays.
 //!
 //! Rays are single-precision values (origins and directions rounded to
 //! `f32`) so that a peer that takes `f32` rays traces exactly the same
@@ -170,9 +176,9 @@ fn time_rays(pool: &rayon::ThreadPool, rays: &[Ray], repetitions: usize, query: 
     (rays.len() as f64 / best / 1e6, hits as f64 / rays.len().max(1) as f64)
 }
 
-/// Measures every mesh: build (1 and 2 threads), then closest-hit on the
-/// primary and incoherent rays and occlusion on the incoherent ones, on 1
-/// and 2 threads.
+/// Measures every mesh: build (1 and 2 threads), then closest-hit (with and
+/// without the hit record) on the primary and incoherent rays and occlusion
+/// on the incoherent ones, on 1 and 2 threads.
 pub fn measure(
     meshes: &[(String, Mesh)],
     repetitions: usize,
@@ -220,17 +226,21 @@ pub fn measure(
 
         let primary = primary_rays(&scene);
         let incoherent = incoherent_rays(&scene, INCOHERENT_RAYS);
-        let cases: [(&str, &[Ray], &'static str); 3] = [
+        let cases: [(&str, &[Ray], &'static str); 5] = [
             ("primary", &primary, "closest"),
+            ("primary", &primary, "distance"),
             ("incoherent", &incoherent, "closest"),
+            ("incoherent", &incoherent, "distance"),
             ("incoherent", &incoherent, "occlusion"),
         ];
         for (set, rays, query) in cases {
             for (pool, threads) in pools.iter().zip([1, 2]) {
-                let (mrays_per_second, hit_fraction) = if query == "closest" {
-                    time_rays(pool, rays, repetitions, |r| scene.intersect(r, f64::INFINITY).is_some())
-                } else {
-                    time_rays(pool, rays, repetitions, |r| scene.occluded(r, f64::INFINITY))
+                let (mrays_per_second, hit_fraction) = match query {
+                    "closest" => time_rays(pool, rays, repetitions, |r| scene.intersect(r, f64::INFINITY).is_some()),
+                    "distance" => time_rays(pool, rays, repetitions, |r| {
+                        scene.nearest_distance(r, f64::INFINITY).is_some()
+                    }),
+                    _ => time_rays(pool, rays, repetitions, |r| scene.occluded(r, f64::INFINITY)),
                 };
                 progress(&format!(
                     "  {set:<10} {query:<9} {threads} thread(s): {mrays_per_second:6.2} Mrays/s ({:.0}% hit)",

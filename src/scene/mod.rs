@@ -454,7 +454,39 @@ impl Scene {
         };
         let mut t = t_max;
         traversal.nearest(&self.bvh, ray, &mut t, &mut visitor);
+        self.hit_record(ray, visitor.nearest)
+    }
+
+    /// The nearest hit's distance along the ray and its primitive, in
+    /// `(0, t_max)`, without the hit record: for queries that need only
+    /// where the ray stops (the viewer's depth under the pointer). It is
+    /// also what a ray-tracing kernel's closest-hit query returns (Embree's
+    /// `rtcIntersect1`: distance, barycentrics, primitive), so that
+    /// `prism bench --rays` can time the same work as Embree's.
+    #[inline]
+    pub fn nearest_distance(&self, ray: &Ray, t_max: f64) -> Option<(f64, u32)> {
+        let mut visitor = NearestVisitor::<false> {
+            scene: self,
+            ray,
+            skipped: u32::MAX,
+            triangle_ray: None,
+            nearest: Nearest::Nothing,
+        };
+        let mut t = t_max;
+        Dispatched.nearest(&self.bvh, ray, &mut t, &mut visitor);
+        // Each leaf test lowers `t` to the nearest hit it finds.
         match visitor.nearest {
+            Nearest::Nothing => None,
+            Nearest::Triangle(found) => Some((t, self.shapes.len() as u32 + found.index)),
+            Nearest::Shape(index, _) => Some((t, index)),
+            Nearest::Record(found) => Some((t, found.primitive)),
+        }
+    }
+
+    /// The hit record of what a nearest-hit query found.
+    #[inline(always)]
+    fn hit_record(&self, ray: &Ray, nearest: Nearest) -> Option<Intersection> {
+        match nearest {
             Nearest::Nothing => None,
             Nearest::Triangle(found) => {
                 let triangle = self.triangles.get(found.index);

@@ -56,8 +56,8 @@ pub fn surface_depth(scene: &Scene, camera: &Camera, film: DVec2, aspect: f64) -
     let mut pinhole = *camera;
     pinhole.aperture_radius = 0.0;
     let ray = pinhole.generate_ray(film, aspect, DVec2::splat(0.5));
-    let hit = scene.intersect(&ray, f64::INFINITY)?;
-    Some(camera.depth_of(hit.hit.point))
+    let (t, _) = scene.nearest_distance(&ray, f64::INFINITY)?;
+    Some(camera.depth_of(ray.at(t)))
 }
 
 /// Columns of the focal-plane overlay grid.
