@@ -13,10 +13,11 @@ Embree's default):
   `closest` (`Scene::intersect`: the query and then the hit record a renderer
   shades with, the point with its error bound, unit normals and uv) and
   `distance` (`Scene::nearest_distance`: the query alone, distance and
-  primitive). The second is the same work as Embree's `rtcIntersect1`, which
+  primitive). The second is the work of Embree's `rtcIntersect1`, which
   returns the distance, barycentrics, an unnormalised geometric normal and
-  the primitive; a renderer on Embree builds its hit record afterwards
-  (Mitsuba's `SurfaceInteraction`);
+  the primitive (Prism's leaf tests find the barycentrics too; the normal,
+  one cross product, they do not make); a renderer on Embree builds its hit
+  record afterwards (Mitsuba's `SurfaceInteraction`);
 - agreement with Prism on the very same rays: hit/miss disagreements, hits
   whose distance differs by more than a relative 1e-5, hits on another
   triangle (legitimate where a ray crosses a shared edge), and occlusion

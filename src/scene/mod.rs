@@ -445,6 +445,34 @@ impl Scene {
         t_max: f64,
         skipped: u32,
     ) -> Option<Intersection> {
+        let (nearest, _) = self.nearest::<SKIP>(traversal, ray, t_max, skipped);
+        self.hit_record(ray, nearest)
+    }
+
+    /// The nearest hit's distance along the ray and its primitive, in
+    /// `(0, t_max)`, without the hit record: for queries that need only
+    /// where the ray stops (the viewer's depth under the pointer). It is
+    /// the work of a ray-tracing kernel's closest-hit query, such as
+    /// Embree's `rtcIntersect1` (whose distance, barycentrics and primitive
+    /// the leaf tests find here too; Embree also returns an unnormalised
+    /// geometric normal), so that `prism bench --rays` can time the same
+    /// work as Embree's.
+    #[inline]
+    pub fn nearest_distance(&self, ray: &Ray, t_max: f64) -> Option<(f64, u32)> {
+        let (nearest, t) = self.nearest::<false>(Dispatched, ray, t_max, u32::MAX);
+        match nearest {
+            Nearest::Nothing => None,
+            Nearest::Triangle(found) => Some((t, self.shapes.len() as u32 + found.index)),
+            Nearest::Shape(index, _) => Some((t, index)),
+            Nearest::Record(found) => Some((t, found.primitive)),
+        }
+    }
+
+    /// What the traversal found nearest, and its distance (each leaf test
+    /// lowers the bound to the nearest hit it finds, so the final bound is
+    /// the distance when something was found).
+    #[inline(always)]
+    fn nearest<const SKIP: bool>(&self, traversal: impl Traversal, ray: &Ray, t_max: f64, skipped: u32) -> (Nearest, f64) {
         let mut visitor = NearestVisitor::<SKIP> {
             scene: self,
             ray,
@@ -454,33 +482,7 @@ impl Scene {
         };
         let mut t = t_max;
         traversal.nearest(&self.bvh, ray, &mut t, &mut visitor);
-        self.hit_record(ray, visitor.nearest)
-    }
-
-    /// The nearest hit's distance along the ray and its primitive, in
-    /// `(0, t_max)`, without the hit record: for queries that need only
-    /// where the ray stops (the viewer's depth under the pointer). It is
-    /// also what a ray-tracing kernel's closest-hit query returns (Embree's
-    /// `rtcIntersect1`: distance, barycentrics, primitive), so that
-    /// `prism bench --rays` can time the same work as Embree's.
-    #[inline]
-    pub fn nearest_distance(&self, ray: &Ray, t_max: f64) -> Option<(f64, u32)> {
-        let mut visitor = NearestVisitor::<false> {
-            scene: self,
-            ray,
-            skipped: u32::MAX,
-            triangle_ray: None,
-            nearest: Nearest::Nothing,
-        };
-        let mut t = t_max;
-        Dispatched.nearest(&self.bvh, ray, &mut t, &mut visitor);
-        // Each leaf test lowers `t` to the nearest hit it finds.
-        match visitor.nearest {
-            Nearest::Nothing => None,
-            Nearest::Triangle(found) => Some((t, self.shapes.len() as u32 + found.index)),
-            Nearest::Shape(index, _) => Some((t, index)),
-            Nearest::Record(found) => Some((t, found.primitive)),
-        }
+        (visitor.nearest, t)
     }
 
     /// The hit record of what a nearest-hit query found.
