@@ -29,12 +29,19 @@ pub fn with_capacity<T>(capacity: usize) -> Vec<T> {
     values
 }
 
+/// `len` copies of `value` in an advised allocation ([`with_capacity`]).
+pub fn filled<T: Clone>(len: usize, value: T) -> Vec<T> {
+    let mut values = with_capacity(len);
+    values.resize(len, value);
+    values
+}
+
 /// Asks the kernel to back the huge pages inside `values`' allocation with
 /// huge pages. Call it before anything is written there: pages already
 /// touched keep their size until the kernel collapses them, if ever.
 /// Advice only, whose answer is ignored: if the kernel declines, or on
 /// other systems, the pages stay as they were, and so does everything else.
-pub fn advise<T>(values: &Vec<T>) {
+fn advise<T>(values: &Vec<T>) {
     let bytes = values.capacity() * std::mem::size_of::<T>();
     let Some(pages) = whole_pages(values.as_ptr() as usize, bytes) else {
         return;

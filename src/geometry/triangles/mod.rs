@@ -133,10 +133,8 @@ impl Triangles {
     pub fn new(triangles: &[(Triangle, u32)], order: &[u32], leaves: &[Leaf], anchors: Vec<DVec3>) -> Self {
         let count = order.len();
         // A large mesh's leaves on huge pages (`accel::huge_pages`).
-        let mut offsets = huge_pages::with_capacity(9 * count + OFFSET_PADDING);
-        offsets.resize(9 * count + OFFSET_PADDING, 0.0f32);
-        let mut records = huge_pages::with_capacity(count + RECORD_PADDING);
-        records.resize(count + RECORD_PADDING, Record::default());
+        let mut offsets = huge_pages::filled(9 * count + OFFSET_PADDING, 0.0f32);
+        let mut records = huge_pages::filled(count + RECORD_PADDING, Record::default());
         let anchor_of = |mesh: u32| anchors.get(mesh as usize).copied().unwrap_or(DVec3::ZERO);
         for leaf in leaves {
             let n = leaf.count as usize;
