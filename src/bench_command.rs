@@ -302,8 +302,11 @@ fn scaling_command(args: &BenchArgs) -> Result<()> {
 
 fn rays_command(args: &BenchArgs) -> Result<()> {
     let bunny_path = PathBuf::from("assets/bunny.obj");
-    let bunny = prism::geometry::Mesh::load_obj(&bunny_path, &prism::geometry::Transform::default())
-        .map_err(|e| anyhow::anyhow!("{}: {e}", bunny_path.display()))?;
+    let bunny = prism::geometry::Mesh::load_obj(&bunny_path, &prism::geometry::Transform::default()).map_err(|e| {
+        anyhow::anyhow!(
+            "{e} (the ray benchmark reads the bunny from the repository's assets folder: run it from the repository root)"
+        )
+    })?;
     let meshes = rays::benchmark_meshes(bunny);
     if let Some(directory) = &args.export_rays {
         rays::export(&meshes, directory)?;

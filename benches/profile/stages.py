@@ -3,7 +3,7 @@
 
 Usage (from the repository root):
     cargo build --profile profiling
-    valgrind --tool=callgrind --callgrind-out-file=cg.out \
+    PRISM_KERNEL=portable valgrind --tool=callgrind --callgrind-out-file=cg.out \
         target/profiling/prism render scenes/cornell.toml \
         --width 64 --height 64 --spp 16 --threads 1 --quiet -o /tmp/x.exr
     python3 benches/profile/stages.py cg.out --samples 65536
@@ -12,6 +12,8 @@ The profiling build keeps line tables, so callgrind attributes inlined code to
 the source file it came from; each (file, function) cost is put in a stage by
 its source file, or by its function when the file is a library's (glam, core,
 libm). Instruction counts are stable on a busy machine, unlike times.
+PRISM_KERNEL=portable runs the baseline copies of the ray queries and path
+loop: Valgrind 3.19 cannot decode every instruction of the AVX2 copies.
 """
 import argparse
 import collections
