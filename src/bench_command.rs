@@ -302,11 +302,15 @@ fn scaling_command(args: &BenchArgs) -> Result<()> {
 
 fn rays_command(args: &BenchArgs) -> Result<()> {
     let bunny_path = PathBuf::from("assets/bunny.obj");
-    let bunny = prism::geometry::Mesh::load_obj(&bunny_path, &prism::geometry::Transform::default()).map_err(|e| {
+    // As the scene loader does: the file's own problem first (it names the
+    // path), then what the OBJ reader found, after the path.
+    prism::geometry::mesh::regular_file(&bunny_path).map_err(|e| {
         anyhow::anyhow!(
             "{e} (the ray benchmark reads the bunny from the repository's assets folder: run it from the repository root)"
         )
     })?;
+    let bunny = prism::geometry::Mesh::load_obj(&bunny_path, &prism::geometry::Transform::default())
+        .map_err(|e| anyhow::anyhow!("{}: {e}", bunny_path.display()))?;
     let meshes = rays::benchmark_meshes(bunny);
     if let Some(directory) = &args.export_rays {
         rays::export(&meshes, directory)?;
