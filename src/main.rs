@@ -37,7 +37,8 @@ enum Command {
     Render(RenderArgs),
     /// Merge film files (parts of one render) into an image or a film file.
     Merge(merge_command::MergeArgs),
-    /// Measure error against time, scaling, or numerical stress (see docs/benchmarks.md).
+    /// Measure error against time, rays and samples per second, scaling, or numerical stress
+    /// (see docs/benchmarks.md and docs/performance.md).
     Bench(bench_command::BenchArgs),
     /// Open the interactive viewer on a scene (the default scene if omitted).
     View {
