@@ -304,7 +304,7 @@ fn rays_command(args: &BenchArgs) -> Result<()> {
     let bunny_path = PathBuf::from("assets/bunny.obj");
     // As the scene loader does: the file's own problem first (it names the
     // path), then what the OBJ reader found, after the path.
-    prism::geometry::mesh::regular_file(&bunny_path).map_err(|e| {
+    prism::input_file::regular_file(&bunny_path).map_err(|e| {
         anyhow::anyhow!(
             "{e} (the ray benchmark reads the bunny from the repository's assets folder: run it from the repository root)"
         )

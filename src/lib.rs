@@ -25,6 +25,7 @@ pub mod denoise;
 pub mod farm;
 pub mod film;
 pub mod geometry;
+pub mod input_file;
 pub mod integrator;
 pub mod light;
 pub mod material;

@@ -209,8 +209,11 @@ fn write_exr(frame: &Frame, path: &Path, exposure_stops: f64, metadata: &[(Strin
 }
 
 /// Reads an image file back as a linear frame (EXR stays linear; 8-bit
-/// formats are sRGB-decoded). Used by benchmarks and tests.
+/// formats are sRGB-decoded). Used by benchmarks, tests and the viewer's
+/// reference image. Errors name the file.
 pub fn load_frame(path: &Path) -> Result<Frame, String> {
+    // A named pipe would block the reader (and the viewer's window with it).
+    crate::input_file::regular_file(path)?;
     let image = image::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let is_float = matches!(
         image,

@@ -2,13 +2,15 @@
 //! separate processes merge into the image of one process, `--part auto`
 //! reads Slurm's and Kubernetes' variables, and every bad merge (another
 //! scene, other settings, overlapping parts, a gap, a truncated, corrupt or
-//! foreign file) fails with an error naming the file and writes nothing.
+//! foreign file, a folder or a named pipe) fails with an error naming the
+//! file and writes nothing.
 
 mod common;
 use common::ScratchDir;
 use prism::output::load_frame;
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
 
 /// Small enough for a debug build: 16×16 pixels, 6 samples, 3 parts.
 const SIZE: [&str; 6] = ["--width", "16", "--height", "16", "--spp", "6"];
@@ -229,7 +231,42 @@ fn bad_merges_name_the_file_and_write_nothing() {
         &["part-0.film", "image.film"],
         "error: image.film: not a Prism film file",
     );
-    refused(folder, &["part-0.film", "absent.film"], "error: absent.film: cannot open");
+    refused(folder, &["part-0.film", "absent.film"], "error: absent.film: no such file");
+    std::fs::create_dir(folder.join("folder.film")).expect("create folder");
+    refused(
+        folder,
+        &["part-0.film", "folder.film"],
+        "error: folder.film: is a directory, not a file",
+    );
+    // A named pipe nobody writes to: opening it to read would block the
+    // merge for ever, so the merge must refuse it without opening it.
+    let pipe = folder.join("pipe.film");
+    if Command::new("mkfifo").arg(&pipe).status().is_ok_and(|s| s.success()) {
+        let mut merge = Command::new(env!("CARGO_BIN_EXE_prism"))
+            .args(["merge", "part-0.film", "pipe.film", "-o", "pipe.exr"])
+            .current_dir(folder)
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("run prism merge");
+        let deadline = Instant::now() + Duration::from_secs(60);
+        let status = loop {
+            if let Some(status) = merge.try_wait().expect("wait for prism merge") {
+                break status;
+            }
+            if Instant::now() > deadline {
+                let _ = merge.kill();
+                panic!("prism merge of a named pipe did not finish within 60 s");
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        };
+        let mut stderr = String::new();
+        if let Some(mut pipe_out) = merge.stderr.take() {
+            std::io::Read::read_to_string(&mut pipe_out, &mut stderr).expect("read stderr");
+        }
+        assert!(!status.success(), "merging a named pipe exited 0");
+        assert!(stderr.starts_with("error: pipe.film: is not a regular file"), "{stderr:?}");
+        assert!(!folder.join("pipe.exr").exists(), "an image was written");
+    }
 }
 
 #[test]

@@ -83,3 +83,31 @@ fn failed_write_leaves_nothing_behind() {
     let unsupported = save_frame(&frame(), &folder.join("d.jpg"), 0.0, ToneMap::Clamp, &[]);
     assert!(unsupported.is_err_and(|e| e.to_string().contains("d.jpg")));
 }
+
+/// Reading an image back refuses what is not a regular file, naming it
+/// once: a named pipe nobody writes to would block the reader (in the
+/// viewer, its window) for ever.
+#[test]
+fn reading_refuses_what_is_not_an_image_file() {
+    let dir = scratch("reading_refuses_what_is_not_an_image_file");
+    let missing = dir.join("missing.exr");
+    let error = load_frame(&missing).err().unwrap_or_default();
+    assert_eq!(error, format!("{}: no such file", missing.display()));
+    let error = load_frame(dir.path()).err().unwrap_or_default();
+    assert_eq!(error, format!("{}: is a directory, not a file", dir.path().display()));
+    let pipe = dir.join("pipe.exr");
+    let made = std::process::Command::new("mkfifo").arg(&pipe).status();
+    if made.is_ok_and(|status| status.success()) {
+        let (sender, receiver) = std::sync::mpsc::channel();
+        let reader_pipe = pipe.clone();
+        std::thread::spawn(move || sender.send(load_frame(&reader_pipe).err()));
+        let error = receiver
+            .recv_timeout(std::time::Duration::from_secs(60))
+            .expect("reading a named pipe did not return within 60 s")
+            .unwrap_or_default();
+        assert_eq!(
+            error,
+            format!("{}: is not a regular file (a device, pipe or socket)", pipe.display())
+        );
+    }
+}

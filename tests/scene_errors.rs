@@ -447,3 +447,18 @@ fn sppm_hang_reproducers_are_refused() {
         assert!(stderr.starts_with(&expected), "{file}: expected {expected:?}, got {stderr:?}");
     }
 }
+
+/// A scene file that is missing, or is a folder, gets one line that names
+/// it once: the file, then what is wrong with it.
+#[test]
+fn an_unreadable_scene_file_is_named_once() {
+    let dir = scratch("an_unreadable_scene_file_is_named_once");
+    let missing = dir.join("missing.toml");
+    let folder = dir.join("folder.toml");
+    std::fs::create_dir(&folder).expect("create folder");
+    for (path, reason) in [(&missing, "no such file"), (&folder, "is a directory, not a file")] {
+        let (success, stderr) = run_with(path, &[]);
+        assert!(!success, "{}: exit code was 0", path.display());
+        assert_eq!(stderr.trim_end(), format!("error: {}: {reason}", path.display()));
+    }
+}

@@ -197,9 +197,19 @@ fn write_varint(mut value: u128, out: &mut Vec<u8>) {
     out.push(value as u8);
 }
 
+/// Checks that `path` is a regular file before it is opened: a folder
+/// would fail obscurely, and reading a named pipe would block the merge.
+fn regular_film_file(path: &Path) -> Result<(), FarmError> {
+    match crate::input_file::not_a_regular_file(path) {
+        Some(reason) => Err(FarmError::io(path, reason)),
+        None => Ok(()),
+    }
+}
+
 /// Reads only the header of the film file at `path` (cheap: for checking
 /// parts against each other before reading any of them whole).
 pub fn read_header(path: &Path) -> Result<FilmHeader, FarmError> {
+    regular_film_file(path)?;
     let mut file = File::open(path).map_err(|e| FarmError::io(path, format!("cannot open: {e}")))?;
     let mut preamble = [0u8; PREAMBLE_BYTES];
     let read = read_up_to(&mut file, &mut preamble).map_err(|e| FarmError::io(path, e))?;
@@ -236,6 +246,7 @@ pub fn read_film(path: &Path) -> Result<(FilmHeader, Film), FarmError> {
 /// be of its size). Every check, the checksum included, passes before
 /// anything is added; on error `film` is unchanged.
 pub fn add_film_file(path: &Path, film: &mut Film) -> Result<FilmHeader, FarmError> {
+    regular_film_file(path)?;
     let bytes = std::fs::read(path).map_err(|e| FarmError::io(path, format!("cannot read: {e}")))?;
     let length = parse_preamble(path, &bytes[..bytes.len().min(PREAMBLE_BYTES)])?;
     let records_start = PREAMBLE_BYTES + length;

@@ -3,6 +3,7 @@
 
 use super::transform::Transform;
 use super::triangle::Triangle;
+use crate::input_file::regular_file;
 use glam::{DVec2, DVec3};
 use std::path::Path;
 
@@ -32,22 +33,6 @@ pub struct ObjFile {
     pub materials: Vec<tobj::Material>,
     /// Why the material libraries could not be read, when they could not.
     pub material_error: Option<String>,
-}
-
-/// Checks that `path` names a regular file (following links) before it is
-/// opened: a directory, a device such as /dev/zero or a pipe would make a
-/// reader fail obscurely, read forever or block.
-pub fn regular_file(path: &Path) -> Result<(), String> {
-    match std::fs::metadata(path) {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(format!("{}: no such file", path.display())),
-        Err(e) => Err(format!("{}: cannot read: {e}", path.display())),
-        Ok(m) if m.is_dir() => Err(format!("{}: is a directory, not a file", path.display())),
-        Ok(m) if !m.is_file() => Err(format!(
-            "{}: is not a regular file (a device, pipe or socket)",
-            path.display()
-        )),
-        Ok(_) => Ok(()),
-    }
 }
 
 impl Mesh {

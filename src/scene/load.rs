@@ -67,7 +67,10 @@ pub fn load_scene_file(path: &Path) -> Result<LoadedScene, SceneError> {
 pub(super) fn load_scene_file_reporting(path: &Path, progress: &dyn Fn(LoadStage)) -> Result<LoadedScene, SceneError> {
     progress(LoadStage::Parsing);
     let cannot_read = |message: String| SceneError::new(path, None, None, message);
-    crate::geometry::mesh::regular_file(path).map_err(&cannot_read)?;
+    // The error names the scene file already.
+    if let Some(reason) = crate::input_file::not_a_regular_file(path) {
+        return Err(cannot_read(reason));
+    }
     let bytes = std::fs::read(path).map_err(|e| cannot_read(format!("cannot read scene file: {e}")))?;
     let base = path.parent().unwrap_or(Path::new("."));
     let mut loaded = load_scene_bytes_reporting(&bytes, path, base, progress)?;

@@ -137,8 +137,8 @@ impl ViewerApp {
             return;
         }
         let path = PathBuf::from(&text);
-        if !path.is_file() {
-            self.open.message = Some(format!("{text}: no such file"));
+        if let Some(reason) = crate::input_file::not_a_regular_file(&path) {
+            self.open.message = Some(format!("{text}: {reason}"));
             return;
         }
         self.open.message = None;
@@ -157,7 +157,8 @@ impl ViewerApp {
                 });
                 self.save.message = None;
             }
-            Err(error) => self.save.message = Some((false, format!("reference {text}: {error}"))),
+            // The error names the file.
+            Err(error) => self.save.message = Some((false, format!("reference {error}"))),
         }
     }
 

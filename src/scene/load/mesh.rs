@@ -18,8 +18,9 @@
 
 use super::{Builder, COORDINATE_LIMIT, SceneParts, out_of_range};
 use crate::color::{Color, luminance};
-use crate::geometry::mesh::{ObjFile, regular_file};
+use crate::geometry::mesh::ObjFile;
 use crate::geometry::{Mesh, Shape};
+use crate::input_file::regular_file;
 use crate::material::Material;
 use crate::material::texture::{Mapping, Projection, Texture, Wrap};
 use crate::scene::Primitive;

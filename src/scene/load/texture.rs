@@ -4,7 +4,7 @@
 use super::Builder;
 use crate::color::Color;
 use crate::geometry::Transform;
-use crate::geometry::mesh::regular_file;
+use crate::input_file::regular_file;
 use crate::material::texture::{Gradient, ImageCache, Mapping, PlanarProjection, Projection, SphereProjection, Texture, Wrap};
 use crate::scene::description::{ColorDescription, MappingKind, Numbers, TextureDescription, Vector, WrapKind};
 use crate::scene::document::FieldPath;
