@@ -251,7 +251,7 @@ impl SettingsPatch {
             if !(low..=high).contains(&radius) {
                 return Err(SettingError::new(
                     Setting::InitialRadius,
-                    format!("must be between {low:e} and {high:e} scene units (found {radius})"),
+                    format!("must be between {low:e} and {high:e} scene units (found {})", shown(radius)),
                 ));
             }
             next.sppm.initial_radius = Some(radius);
@@ -260,7 +260,7 @@ impl SettingsPatch {
             if !(alpha > 0.0 && alpha < 1.0) {
                 return Err(SettingError::new(
                     Setting::Alpha,
-                    format!("must be strictly between 0 and 1 (found {alpha})"),
+                    format!("must be strictly between 0 and 1 (found {})", shown(alpha)),
                 ));
             }
             next.sppm.alpha = alpha;
@@ -270,7 +270,7 @@ impl SettingsPatch {
             if !(threshold.is_finite() && threshold > 0.0) {
                 return Err(SettingError::new(
                     Setting::AdaptiveThreshold,
-                    format!("must be a positive finite number (found {threshold})"),
+                    format!("must be a positive finite number (found {})", shown(threshold)),
                 ));
             }
             next.adaptive_threshold = Some(threshold);
@@ -279,6 +279,17 @@ impl SettingsPatch {
         next.caustic_light_paths = self.caustic_light_paths.unwrap_or(next.caustic_light_paths);
         *settings = next;
         Ok(())
+    }
+}
+
+/// A refused value as a person would write it: Rust prints `1e300` as 301
+/// digits, so magnitudes outside [10⁻⁴, 10⁶) are shown with an exponent.
+fn shown(value: f64) -> String {
+    let magnitude = value.abs();
+    if value.is_finite() && magnitude != 0.0 && !(1e-4..1e6).contains(&magnitude) {
+        format!("{value:e}")
+    } else {
+        format!("{value}")
     }
 }
 
@@ -306,7 +317,10 @@ pub fn time_limit(seconds: f64) -> Result<Duration, SettingError> {
     if !(seconds > 0.0 && seconds <= MAX_TIME_SECONDS) {
         return Err(SettingError::new(
             Setting::TimeLimit,
-            format!("must be a number of seconds above 0 and at most {MAX_TIME_SECONDS:e} (found {seconds})"),
+            format!(
+                "must be a number of seconds above 0 and at most {MAX_TIME_SECONDS:e} (found {})",
+                shown(seconds)
+            ),
         ));
     }
     Ok(Duration::from_secs_f64(seconds))
@@ -328,7 +342,10 @@ pub fn exposure(stops: f64) -> Result<f64, SettingError> {
     if !(stops.is_finite() && stops.abs() <= MAX_EXPOSURE_STOPS) {
         return Err(SettingError::new(
             Setting::Exposure,
-            format!("must be a finite number of stops between -{MAX_EXPOSURE_STOPS} and {MAX_EXPOSURE_STOPS} (found {stops})"),
+            format!(
+                "must be a finite number of stops between -{MAX_EXPOSURE_STOPS} and {MAX_EXPOSURE_STOPS} (found {})",
+                shown(stops)
+            ),
         ));
     }
     Ok(stops)
@@ -391,6 +408,19 @@ pub fn format_bytes(bytes: u64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn refused_values_are_shown_briefly() {
+        assert_eq!(shown(1e300), "1e300");
+        assert_eq!(shown(-2.5e-9), "-2.5e-9");
+        assert_eq!(shown(1.5), "1.5");
+        assert_eq!(shown(-1.0), "-1");
+        assert_eq!(shown(0.0), "0");
+        assert_eq!(shown(f64::NAN), "NaN");
+        assert_eq!(shown(f64::INFINITY), "inf");
+        let error = time_limit(1e300).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(error.ends_with("(found 1e300)"), "{error}");
+    }
 
     #[test]
     fn a_patch_is_applied_whole_or_not_at_all() {
