@@ -82,22 +82,24 @@ pub struct PendingImage {
 impl PendingImage {
     /// Checks the format and creates the (empty) temporary file.
     pub fn create(path: &Path) -> Result<Self, OutputError> {
-        let format = ImageFormat::from_path(path).ok_or_else(|| OutputError::UnsupportedFormat {
-            path: path.to_path_buf(),
-        })?;
         let failed = |message: String| OutputError::Write {
             path: path.to_path_buf(),
             message,
         };
+        // Before the format: `-o out` naming a folder is that mistake, not
+        // a missing extension.
+        if path.is_dir() {
+            return Err(failed("is a directory".into()));
+        }
+        let format = ImageFormat::from_path(path).ok_or_else(|| OutputError::UnsupportedFormat {
+            path: path.to_path_buf(),
+        })?;
         let directory = match path.parent() {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         };
         if !directory.is_dir() {
             return Err(failed(format!("folder {} does not exist", directory.display())));
-        }
-        if path.is_dir() {
-            return Err(failed("is a directory".into()));
         }
         let file_name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         let temporary = directory.join(format!(".{file_name}.{}.tmp", std::process::id()));

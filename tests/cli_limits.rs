@@ -156,6 +156,13 @@ fn the_output_is_checked_before_rendering() {
         &["--time", "5", "-o", &folder_text],
         &format!("error: {folder_text}: cannot write image: is a directory"),
     );
+    // A folder without an image extension: the folder is the mistake.
+    let folder_text = dir.path().display().to_string();
+    refused(
+        &dir,
+        &["--time", "5", "-o", &folder_text],
+        &format!("error: {folder_text}: cannot write image: is a directory"),
+    );
     assert!(started.elapsed() < Duration::from_secs(4), "rendered before failing");
 }
 
