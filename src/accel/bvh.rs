@@ -145,6 +145,8 @@ pub trait LeafVisitor {
 pub trait Traversal: Copy {
     /// [`Bvh::traverse_nearest`], by this route.
     fn nearest(self, bvh: &Bvh, ray: &Ray, t_max: &mut f64, visitor: &mut impl LeafVisitor);
+    /// [`Bvh::traverse_any`], by this route.
+    fn any(self, bvh: &Bvh, ray: &Ray, t_max: &mut f64, visitor: &mut impl LeafVisitor);
 }
 
 /// The tree's own choice of kernel, made per query ([`Bvh::traverse_nearest`]).
@@ -155,6 +157,10 @@ impl Traversal for Dispatched {
     #[inline(always)]
     fn nearest(self, bvh: &Bvh, ray: &Ray, t_max: &mut f64, visitor: &mut impl LeafVisitor) {
         bvh.traverse_nearest(ray, t_max, visitor);
+    }
+    #[inline(always)]
+    fn any(self, bvh: &Bvh, ray: &Ray, t_max: &mut f64, visitor: &mut impl LeafVisitor) {
+        bvh.traverse_any(ray, t_max, visitor);
     }
 }
 
@@ -167,6 +173,10 @@ impl Traversal for Portable {
     fn nearest(self, bvh: &Bvh, ray: &Ray, t_max: &mut f64, visitor: &mut impl LeafVisitor) {
         bvh.traverse_compiled::<true>(None, ray, t_max, visitor);
     }
+    #[inline(always)]
+    fn any(self, bvh: &Bvh, ray: &Ray, t_max: &mut f64, visitor: &mut impl LeafVisitor) {
+        bvh.traverse_compiled::<false>(None, ray, t_max, visitor);
+    }
 }
 
 /// The AVX2 kernel compiled into the caller, which should itself be
@@ -175,6 +185,10 @@ impl Traversal for Avx2 {
     #[inline(always)]
     fn nearest(self, bvh: &Bvh, ray: &Ray, t_max: &mut f64, visitor: &mut impl LeafVisitor) {
         bvh.traverse_compiled::<true>(Some(self), ray, t_max, visitor);
+    }
+    #[inline(always)]
+    fn any(self, bvh: &Bvh, ray: &Ray, t_max: &mut f64, visitor: &mut impl LeafVisitor) {
+        bvh.traverse_compiled::<false>(Some(self), ray, t_max, visitor);
     }
 }
 

@@ -513,7 +513,7 @@ impl Scene {
     /// at the first hit found.
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f64) -> bool {
-        self.occluded_skipping::<false>(ray, t_max, u32::MAX, u32::MAX)
+        self.occluded_skipping::<false>(Dispatched, ray, t_max, u32::MAX, u32::MAX)
     }
 
     /// [`Scene::occluded`] for a shadow ray from one surface to a point on
@@ -522,13 +522,28 @@ impl Scene {
     /// it is aimed at (a segment meets a plane once, and it ends there).
     #[inline]
     pub fn occluded_between(&self, ray: &Ray, t_max: f64, from: Leaving, to: Leaving) -> bool {
-        self.occluded_skipping::<true>(ray, t_max, from.shape_index(), to.shape_index())
+        self.occluded_skipping::<true>(Dispatched, ray, t_max, from.shape_index(), to.shape_index())
+    }
+
+    /// [`Scene::occluded_between`] compiled into its caller, as
+    /// [`Scene::intersect_leaving_inlined`] is and for the same loop: the
+    /// shadow ray reaches the traversal in registers, not through memory.
+    #[inline(always)]
+    pub fn occluded_between_inlined(&self, traversal: impl Traversal, ray: &Ray, t_max: f64, from: Leaving, to: Leaving) -> bool {
+        self.occluded_skipping::<true>(traversal, ray, t_max, from.shape_index(), to.shape_index())
     }
 
     /// Whether anything but shapes `skipped` and `target` (when `SKIP`)
     /// lies on the ray before `t_max`.
     #[inline(always)]
-    fn occluded_skipping<const SKIP: bool>(&self, ray: &Ray, t_max: f64, skipped: u32, target: u32) -> bool {
+    fn occluded_skipping<const SKIP: bool>(
+        &self,
+        traversal: impl Traversal,
+        ray: &Ray,
+        t_max: f64,
+        skipped: u32,
+        target: u32,
+    ) -> bool {
         let mut visitor = OcclusionVisitor::<SKIP> {
             scene: self,
             ray,
@@ -537,7 +552,7 @@ impl Scene {
             found: false,
         };
         let mut t = t_max;
-        self.bvh.traverse_any(ray, &mut t, &mut visitor);
+        traversal.any(&self.bvh, ray, &mut t, &mut visitor);
         visitor.found
     }
 

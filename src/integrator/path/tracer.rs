@@ -268,7 +268,12 @@ impl PathTracer {
                         // ends no later than |light − origin| − |error| would.
                         let offset = (shadow.origin - hit.point).abs().element_sum();
                         let t_max = light.distance * (1.0 - 1e-9) - light.point_error.abs().element_sum() - offset;
-                        if !scene.occluded_between(&shadow, t_max, here, scene.leaving(light.primitive)) {
+                        let to = scene.leaving(light.primitive);
+                        let occluded = match balls {
+                            true => scene.occluded_between(&shadow, t_max, here, to),
+                            false => scene.occluded_between_inlined(traversal, &shadow, t_max, here, to),
+                        };
+                        if !occluded {
                             let weight = power_heuristic(light.pdf, material.pdf(wo, wi));
                             let f = C::from_rgb(f, wavelengths);
                             radiance += throughput * f * C::emission(light.emission, wavelengths) * (weight / light.pdf);
