@@ -32,6 +32,7 @@ use prism::material::Material;
 use prism::material::texture::Texture;
 use prism::math::Ray;
 use prism::math::ray::{gamma, offset_ray_origin};
+use prism::math::trig::INVERSE_FACTORIALS;
 use prism::math::warp::power_heuristic;
 use prism::sampler::Sampler;
 use prism::scene::{Leaving, Scene, load_scene_file};
@@ -255,19 +256,6 @@ fn dot(a: [f64x4; 3], b: [f64x4; 3]) -> f64x4 {
 fn select(mask: f64x4, a: f64x4, b: f64x4) -> f64x4 {
     mask.blend(a, b)
 }
-
-/// 1/n! for the sine and cosine series (as `math::trig`).
-const INVERSE_FACTORIALS: [f64; 19] = {
-    let mut table = [1.0; 19];
-    let mut factorial = 1.0;
-    let mut n = 1;
-    while n < 19 {
-        factorial *= n as f64;
-        table[n] = 1.0 / factorial;
-        n += 1;
-    }
-    table
-};
 
 /// `math::trig::cos_sin_eighth` in four lanes (the same operations).
 #[inline(always)]
