@@ -7,6 +7,7 @@
 //! - [`bvh`]: the eight-wide tree collapsed from it, and its traversal;
 //! - [`bounds`]: the outward-rounded single-precision boxes both use;
 //! - [`kernel`]: which instructions the queries run with, chosen at run time;
+//! - [`quad_packets`]: four rays at a time against a scene of a few quads, without a tree;
 //! - `huge_pages`: large arrays asked onto 2 MiB pages;
 //! - `slab_test`: the conservative box test of a node's children.
 
@@ -16,8 +17,10 @@ pub mod bvh;
 pub mod collapse;
 pub(crate) mod huge_pages;
 pub mod kernel;
+pub mod quad_packets;
 mod slab_test;
 
 pub use build::LeafKind;
 pub use bvh::{BuildPrimitive, Bvh, Dispatched, Leaf, LeafVisitor, Portable, Traversal, TraversalRay};
 pub use kernel::{Avx2, Kernel};
+pub use quad_packets::{QuadPackets, RayLanes};

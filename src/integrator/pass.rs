@@ -109,6 +109,46 @@ pub fn add_samples_where(
     !cancel.load(Ordering::Relaxed)
 }
 
+/// [`add_samples_adaptive`] for a sampler of whole rows: `sample_row(y,
+/// columns, values)` writes into `values` one sample for each pixel of row
+/// `y` in `columns` (in that order).
+pub fn add_sample_rows_adaptive(
+    film: &mut Film,
+    (pixels, rows): (PixelRect, RowSet),
+    cancel: &AtomicBool,
+    threshold: Option<f64>,
+    sample_row: impl Fn(u32, &[u32], &mut Vec<Color>) + Sync,
+) -> bool {
+    let active = |pixel: &PixelAccumulator| threshold.is_none_or(|threshold| !is_converged(pixel, threshold));
+    let width = film.width as usize;
+    let (x0, lines) = (pixels.x0, pixels.y0 as usize..pixels.y1 as usize);
+    let columns = pixels.x0 as usize..pixels.x1 as usize;
+    let rejected = AtomicU64::new(0);
+    // One row per job, as in `add_samples_where`.
+    let film_rows = film.pixels.par_chunks_mut(width).with_max_len(1).enumerate();
+    film_rows.skip(lines.start).take(lines.len()).for_each_init(
+        || (Vec::new(), Vec::new()),
+        |(sampled, values), (y, row)| {
+            if cancel.load(Ordering::Relaxed) || !rows.contains(y as u32) {
+                return;
+            }
+            let row = &mut row[columns.clone()];
+            sampled.clear();
+            sampled.extend((x0..).zip(row.iter()).filter(|(_, pixel)| active(pixel)).map(|(x, _)| x));
+            sample_row(y as u32, sampled, values);
+            let mut row_rejected = 0;
+            for (&x, &value) in sampled.iter().zip(values.iter()) {
+                add_finite(&mut row[(x - x0) as usize], value, &mut row_rejected);
+            }
+            if row_rejected > 0 {
+                rejected.fetch_add(row_rejected, Ordering::Relaxed);
+            }
+        },
+    );
+    film.rejected_samples += rejected.into_inner();
+    !cancel.load(Ordering::Relaxed)
+}
+
 /// Adds `value` unless the film refuses it (NaN, infinite or beyond
 /// `film::MAX_SAMPLE_VALUE`), which is counted instead.
 #[inline]

@@ -16,7 +16,7 @@ use std::f64::consts::FRAC_PI_2;
 
 /// 1/n! for n = 0 … 18, each correctly rounded (n! itself is exact in `f64`
 /// up to 22!, so only the division rounds). Public for code that evaluates
-/// the same series in SIMD lanes (`examples/wavefront_box.rs`).
+/// the same series in SIMD lanes (`integrator::path::diffuse_lanes`).
 pub const INVERSE_FACTORIALS: [f64; 19] = {
     let mut table = [1.0; 19];
     let mut factorial = 1.0;

@@ -7,15 +7,19 @@
 pub mod ball_connection;
 pub mod caustic_emission;
 pub mod caustic_paths;
+mod diffuse_lanes;
+mod diffuse_rows;
 pub mod lens_connection;
 pub mod tracer;
 
 pub use tracer::PathTracer;
 
 use caustic_emission::CausticEmission;
+use diffuse_rows::{DiffuseQuads, RowPaths};
 use lens_connection::LensView;
 
 use super::{Integrator, RowSet, Share, pass};
+use crate::accel::Avx2;
 use crate::camera::Camera;
 use crate::film::{Film, Frame, LightSplats};
 use crate::math::Ray;
@@ -45,6 +49,9 @@ pub struct PathIntegrator {
     /// Where light paths for caustics are aimed, built at the first pass
     /// that traces them (a render's scene does not change).
     caustic_emission: Option<CausticEmission>,
+    /// For a scene of a few diffuse quads lit by one quad light, the rows'
+    /// kernel ([`diffuse_rows`]), found at the first pass.
+    diffuse_quads: Option<DiffuseQuads>,
 }
 
 /// How far adaptive sampling has come, counted after each pass in one
@@ -115,6 +122,7 @@ impl PathIntegrator {
             adaptive_threshold: settings.adaptive_threshold,
             adaptive: AdaptiveProgress::default(),
             caustic_emission: None,
+            diffuse_quads: None,
         }
     }
 }
@@ -155,6 +163,39 @@ impl PathIntegrator {
             let ray = camera_ray(camera, size, x, y, &mut sampler);
             radiance(&tracer, scene, ray, &mut sampler)
         })
+    }
+}
+
+impl PathIntegrator {
+    /// [`PathIntegrator::add_pass`] by whole rows with `kernel`, its rays
+    /// four at a time in AVX instructions (`avx2`).
+    fn add_pass_by_rows(
+        &mut self,
+        kernel: &DiffuseQuads,
+        avx2: Avx2,
+        scene: &Scene,
+        camera: &Camera,
+        cancel: &AtomicBool,
+    ) -> bool {
+        let sample_index = self.first_sample + self.passes;
+        let (kind, seed) = (self.sampler, self.seed);
+        let size = (self.film.width, self.film.height);
+        let sampled = (self.settings.sampled_pixels(), self.rows);
+        let sample_row = |y: u32, columns: &[u32], values: &mut Vec<crate::color::Color>| {
+            let start = |x: u32| {
+                let mut sampler = Sampler::new(kind, y as u64 * size.0 as u64 + x as u64, sample_index, seed);
+                let ray = camera_ray(camera, size, x, y, &mut sampler);
+                (sampler, ray)
+            };
+            // The row's loop compiled for AVX2, the four-ray queries inside.
+            RowPaths::with(|paths| {
+                avx2.run(
+                    #[inline(always)]
+                    || kernel.radiance_of_row(avx2, scene, columns, start, paths, values),
+                )
+            })
+        };
+        pass::add_sample_rows_adaptive(&mut self.film, sampled, cancel, self.adaptive_threshold, sample_row)
     }
 }
 
@@ -201,6 +242,7 @@ impl Integrator for PathIntegrator {
             let size = (self.film.width, self.film.height);
             let lens = light_traced && lens_connection::scene_has_lens_connections(scene);
             self.tracer.lens_connections = lens.then(|| LensView::new(scene, camera, size));
+            self.diffuse_quads = DiffuseQuads::of(scene, &self.tracer);
         }
         if light_traced {
             let pixels = self.settings.sampled_pixels();
@@ -223,9 +265,15 @@ impl Integrator for PathIntegrator {
                 return false;
             }
         }
-        // RGB or spectral, chosen once per pass: each is its own compiled loop.
+        // RGB or spectral, chosen once per pass: each is its own compiled
+        // loop; a scene of a few diffuse quads in RGB has a kernel of its own
+        // where AVX2 runs its four-ray queries.
         let completed = if spectral {
             self.add_pass(scene, camera, cancel, PathTracer::spectral_radiance)
+        } else if let (Some(kernel), Some(avx2)) = (self.diffuse_quads.take(), scene.bvh().avx2()) {
+            let completed = self.add_pass_by_rows(&kernel, avx2, scene, camera, cancel);
+            self.diffuse_quads = Some(kernel);
+            completed
         } else {
             self.add_pass(scene, camera, cancel, PathTracer::radiance)
         };

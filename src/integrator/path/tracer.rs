@@ -20,7 +20,7 @@ use crate::spectrum::{Radiance, SampledSpectrum, SampledWavelengths};
 use glam::DVec2;
 
 /// Bounces before Russian roulette may end a path.
-const ROULETTE_START: u32 = 3;
+pub(super) const ROULETTE_START: u32 = 3;
 
 /// One bounce's draws from the sampler. Every bounce takes the same five
 /// dimensions in the same order (light choice, point on the light, BSDF
