@@ -11,6 +11,8 @@
 //! `f32` their hit points carry errors larger than the room's details.
 
 pub mod aabb;
+#[cfg(target_arch = "x86_64")]
+pub mod avx_lanes;
 pub mod bernstein;
 pub mod chi_square;
 pub mod frame;

@@ -147,7 +147,7 @@ impl DiffuseQuads {
             }
             self.closest_hits(avx2, scene, bounce, paths);
             paths.hits.pad();
-            shade(&paths.hits, &self.light, &mut paths.shaded);
+            shade(avx2, &paths.hits, &self.light, &mut paths.shaded);
             self.shadow_rays(avx2, paths);
             paths.go_on(bounce);
         }
