@@ -101,16 +101,6 @@ impl QuadPackets {
         &self.quads[index as usize]
     }
 
-    /// How many quads.
-    pub fn len(&self) -> usize {
-        self.quads.len()
-    }
-
-    /// Never: a scene without quads has no packets.
-    pub fn is_empty(&self) -> bool {
-        self.quads.is_empty()
-    }
-
     /// The nearest hit of each of four rays in `(0, ∞)`, passing over quad
     /// `skipped[lane]` in its lane (`u32::MAX`: none). Always inlined: in
     /// a caller compiled for AVX2 ([`Avx2::run`]) its instructions are.

@@ -164,19 +164,14 @@ impl PathIntegrator {
             radiance(&tracer, scene, ray, &mut sampler)
         })
     }
-}
 
-impl PathIntegrator {
-    /// [`PathIntegrator::add_pass`] by whole rows with `kernel`, its rays
-    /// four at a time in AVX instructions (`avx2`).
-    fn add_pass_by_rows(
-        &mut self,
-        kernel: &DiffuseQuads,
-        avx2: Avx2,
-        scene: &Scene,
-        camera: &Camera,
-        cancel: &AtomicBool,
-    ) -> bool {
+    /// [`PathIntegrator::add_pass`] by whole rows with the diffuse kernel
+    /// (`self.diffuse_quads`), its rays four at a time in AVX instructions
+    /// (`avx2`).
+    fn add_pass_by_rows(&mut self, avx2: Avx2, scene: &Scene, camera: &Camera, cancel: &AtomicBool) -> bool {
+        let Some(kernel) = &self.diffuse_quads else {
+            return self.add_pass(scene, camera, cancel, PathTracer::radiance);
+        };
         let sample_index = self.first_sample + self.passes;
         let (kind, seed) = (self.sampler, self.seed);
         let size = (self.film.width, self.film.height);
@@ -270,10 +265,8 @@ impl Integrator for PathIntegrator {
         // where AVX2 runs its four-ray queries.
         let completed = if spectral {
             self.add_pass(scene, camera, cancel, PathTracer::spectral_radiance)
-        } else if let (Some(kernel), Some(avx2)) = (self.diffuse_quads.take(), scene.bvh().avx2()) {
-            let completed = self.add_pass_by_rows(&kernel, avx2, scene, camera, cancel);
-            self.diffuse_quads = Some(kernel);
-            completed
+        } else if let (true, Some(avx2)) = (self.diffuse_quads.is_some(), scene.bvh().avx2()) {
+            self.add_pass_by_rows(avx2, scene, camera, cancel)
         } else {
             self.add_pass(scene, camera, cancel, PathTracer::radiance)
         };
