@@ -29,6 +29,19 @@ pub struct F64x4(__m256d);
 // `Avx2` did (`splat` and `new` take one; everything else is made from
 // `F64x4`s), so the CPU has AVX2; the intrinsics touch no memory.
 
+/// Comparison methods, one `vcmppd` predicate each.
+macro_rules! comparisons {
+    ($($(#[$doc:meta])* $name:ident, $predicate:ident;)*) => {
+        $(
+            $(#[$doc])*
+            #[inline(always)]
+            pub fn $name(self, other: Self) -> Self {
+                Self(unsafe { _mm256_cmp_pd::<$predicate>(self.0, other.0) })
+            }
+        )*
+    };
+}
+
 impl F64x4 {
     /// `value` in every lane.
     #[inline(always)]
@@ -66,28 +79,15 @@ impl F64x4 {
         Self(unsafe { _mm256_castsi256_pd(bits) })
     }
 
-    /// Lanes where `self == other` (false for NaN).
-    #[inline(always)]
-    pub fn cmp_eq(self, other: Self) -> Self {
-        Self(unsafe { _mm256_cmp_pd::<_CMP_EQ_OQ>(self.0, other.0) })
-    }
-
-    /// Lanes where `self != other` (true for NaN, as the scalar operator).
-    #[inline(always)]
-    pub fn cmp_ne(self, other: Self) -> Self {
-        Self(unsafe { _mm256_cmp_pd::<_CMP_NEQ_UQ>(self.0, other.0) })
-    }
-
-    /// Lanes where `self < other`.
-    #[inline(always)]
-    pub fn cmp_lt(self, other: Self) -> Self {
-        Self(unsafe { _mm256_cmp_pd::<_CMP_LT_OQ>(self.0, other.0) })
-    }
-
-    /// Lanes where `self > other`.
-    #[inline(always)]
-    pub fn cmp_gt(self, other: Self) -> Self {
-        Self(unsafe { _mm256_cmp_pd::<_CMP_GT_OQ>(self.0, other.0) })
+    comparisons! {
+        /// Lanes where `self == other` (false for NaN).
+        cmp_eq, _CMP_EQ_OQ;
+        /// Lanes where `self != other` (true for NaN, as the scalar operator).
+        cmp_ne, _CMP_NEQ_UQ;
+        /// Lanes where `self < other`.
+        cmp_lt, _CMP_LT_OQ;
+        /// Lanes where `self > other`.
+        cmp_gt, _CMP_GT_OQ;
     }
 
     /// With `self` a mask: `when_set` where it is set, `otherwise` elsewhere.

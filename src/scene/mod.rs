@@ -20,7 +20,7 @@ pub use progress::{LoadStage, load_scene_file_with_progress};
 pub use similarity::{Similarity, load_scene_str_placed};
 pub use specular_balls::{MAX_SPECULAR_BALLS, SpecularBall};
 
-use crate::accel::{BuildPrimitive, Bvh, Dispatched, Kernel, Leaf, LeafKind, QuadPackets, Traversal};
+use crate::accel::{BuildPrimitive, Bvh, Dispatched, Kernel, Leaf, LeafKind, Traversal};
 use crate::color::Color;
 use crate::geometry::clipped_sphere::clip_emitters;
 use crate::geometry::spheres::Spheres;
@@ -111,9 +111,6 @@ pub struct Scene {
     bvh: Bvh,
     /// The spheres of smooth glass and mirror (see [`specular_balls`]).
     specular_balls: Vec<SpecularBall>,
-    /// In a scene of a few quads and nothing else, its queries four rays
-    /// at a time (see [`crate::accel::quad_packets`]).
-    quad_packets: Option<QuadPackets>,
 }
 
 impl Scene {
@@ -225,17 +222,6 @@ impl Scene {
                     _ => None,
                 }),
         );
-        let quads: Vec<_> = shapes
-            .iter()
-            .map_while(|primitive| match primitive.shape {
-                Shape::Quad(quad) => Some(quad),
-                _ => None,
-            })
-            .collect();
-        let quad_packets = match triangle_count == 0 && quads.len() == shapes.len() {
-            true => QuadPackets::new(quads),
-            false => None,
-        };
         let shape_reads_uv = shapes
             .iter()
             .map(|shape| materials.get(shape.material as usize).is_some_and(Material::reads_uv))
@@ -252,7 +238,6 @@ impl Scene {
             background,
             bvh,
             specular_balls: Vec::new(),
-            quad_packets,
         };
         let lights: Vec<Light> = (0..scene.primitive_count() as u32)
             .filter_map(|primitive| match scene.material_of(primitive) {
@@ -546,12 +531,6 @@ impl Scene {
     #[inline(always)]
     pub fn occluded_between_inlined(&self, traversal: impl Traversal, ray: &Ray, t_max: f64, from: Leaving, to: Leaving) -> bool {
         self.occluded_skipping::<true>(traversal, ray, t_max, from.shape_index(), to.shape_index())
-    }
-
-    /// The four-ray queries of a scene of a few quads and nothing else
-    /// (primitive i is the packets' quad i); `None` for any other scene.
-    pub fn quad_packets(&self) -> Option<&QuadPackets> {
-        self.quad_packets.as_ref()
     }
 
     /// Whether anything but shapes `skipped` and `target` (when `SKIP`)

@@ -63,10 +63,17 @@ impl DiffuseQuads {
     /// emissive, one light (a one-sided quad of uniform RGB radiance), a
     /// black background, and light sampling on.
     pub(super) fn of(scene: &Scene, tracer: &PathTracer) -> Option<Self> {
-        let packets = scene.quad_packets()?.clone();
         if !tracer.light_sampling || scene.background != Color::ZERO {
             return None;
         }
+        // Primitive i is quad i of the packets.
+        let quads = (0..scene.primitive_count() as u32)
+            .map(|primitive| match scene.emitter(primitive) {
+                Emitter::Shape(Shape::Quad(quad)) => Some(*quad),
+                _ => None,
+            })
+            .collect::<Option<Vec<_>>>()?;
+        let packets = QuadPackets::new(quads)?;
         let [light] = scene.lights.lights.as_slice() else {
             return None;
         };
