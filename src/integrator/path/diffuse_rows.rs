@@ -276,6 +276,13 @@ impl DiffuseQuads {
     }
 }
 
+/// `buffer` as `n` copies of `value`, keeping its allocation.
+#[inline(always)]
+fn refill<T: Clone>(buffer: &mut Vec<T>, n: usize, value: T) {
+    buffer.clear();
+    buffer.resize(n, value);
+}
+
 thread_local! {
     static ROW_PATHS: std::cell::RefCell<RowPaths> = std::cell::RefCell::new(RowPaths::default());
 }
@@ -300,17 +307,11 @@ impl RowPaths {
             self.active.push(slot as u32);
         }
         let n = columns.len();
-        for buffer in [&mut self.throughput, &mut self.radiance] {
-            buffer.clear();
-        }
-        self.throughput.resize(n, Color::ONE);
-        self.radiance.resize(n, Color::ZERO);
-        self.previous_pdf.clear();
-        self.previous_pdf.resize(n, 0.0);
-        self.previous_point.clear();
-        self.previous_point.resize(n, DVec3::ZERO);
-        self.leaving.clear();
-        self.leaving.resize(n, Leaving::Nothing);
+        refill(&mut self.throughput, n, Color::ONE);
+        refill(&mut self.radiance, n, Color::ZERO);
+        refill(&mut self.previous_pdf, n, 0.0);
+        refill(&mut self.previous_point, n, DVec3::ZERO);
+        refill(&mut self.leaving, n, Leaving::Nothing);
     }
 
     /// Stage 4: each shaded path's throughput, next ray and Russian
