@@ -158,8 +158,12 @@ impl PathIntegrator {
         let (tracer, kind, seed) = (self.tracer, self.sampler, self.seed);
         let size = (self.film.width, self.film.height);
         let (pixels, rows) = (self.settings.sampled_pixels(), self.rows);
+        let (avx2, ahead) = (Avx2::detect(), dimensions_drawn_ahead(camera.has_lens()));
         pass::add_samples_adaptive(&mut self.film, pixels, rows, cancel, self.adaptive_threshold, |x, y| {
             let mut sampler = Sampler::new(kind, y as u64 * size.0 as u64 + x as u64, sample_index, seed);
+            if let Some(avx2) = avx2 {
+                sampler.draw_ahead(avx2, ahead);
+            }
             let ray = camera_ray(camera, size, x, y, &mut sampler);
             radiance(&tracer, scene, ray, &mut sampler)
         })
@@ -176,9 +180,11 @@ impl PathIntegrator {
         let (kind, seed) = (self.sampler, self.seed);
         let size = (self.film.width, self.film.height);
         let sampled = (self.settings.sampled_pixels(), self.rows);
+        let ahead = dimensions_drawn_ahead(camera.has_lens());
         let sample_row = |y: u32, columns: &[u32], values: &mut Vec<crate::color::Color>| {
             let start = |x: u32| {
                 let mut sampler = Sampler::new(kind, y as u64 * size.0 as u64 + x as u64, sample_index, seed);
+                sampler.draw_ahead(avx2, ahead);
                 let ray = camera_ray(camera, size, x, y, &mut sampler);
                 (sampler, ray)
             };
@@ -192,6 +198,16 @@ impl PathIntegrator {
         };
         pass::add_sample_rows_adaptive(&mut self.film, sampled, cancel, self.adaptive_threshold, sample_row)
     }
+}
+
+/// The 2D draws a path reads first, computed together when its pixel
+/// sample starts ([`Sampler::draw_ahead`]): the film position (dimension
+/// 1), the lens's (2) if the camera has one, and the first bounce's light
+/// point and direction (4 and 5); a pinhole's fourth is the second
+/// bounce's light point (9). The tracer's `BounceDraws` lays out these
+/// dimensions.
+fn dimensions_drawn_ahead(lens: bool) -> [u32; 4] {
+    if lens { [1, 2, 4, 5] } else { [1, 4, 5, 9] }
 }
 
 /// The camera ray of one pixel sample; consumes the sampler's first two

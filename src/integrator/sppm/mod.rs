@@ -46,6 +46,7 @@ pub use settings::{RadiusSchedule, SppmSettings};
 
 use super::path::camera_ray;
 use super::{Integrator, Share};
+use crate::accel::Avx2;
 use crate::camera::Camera;
 use crate::color::Color;
 use crate::film::{Film, Frame};
@@ -324,6 +325,7 @@ impl SppmIntegrator {
         let (kind, iteration, max_depth) = (self.sampler, self.iteration(), self.max_depth);
         let seed = self.seed ^ PHOTON_SEED;
         let inverse_unit = 1.0 / flux_unit(sources);
+        let avx2 = Avx2::detect();
         (0..self.parameters.photons_per_iteration)
             .into_par_iter()
             .with_min_len(64)
@@ -333,6 +335,9 @@ impl SppmIntegrator {
                     return;
                 }
                 let mut sampler = Sampler::new(kind, index as u64, iteration, seed);
+                if let Some(avx2) = avx2 {
+                    sampler.draw_ahead(avx2, photon::DIMENSIONS_DRAWN_AHEAD);
+                }
                 let Some(emitted) = sources.emit::<C>(scene, &mut sampler) else {
                     return;
                 };

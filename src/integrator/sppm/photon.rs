@@ -113,6 +113,13 @@ impl PhotonSources {
     }
 }
 
+/// The 2D draws of a photon from a shape, computed together when its
+/// stream starts ([`crate::sampler::Sampler::draw_ahead`]): the point on the
+/// light (dimension 2, after the light's choice) and the direction from it
+/// (3), then, after the side's draw, the first two bounces' directions (5
+/// and 8; each bounce draws direction, lobe and roulette).
+pub const DIMENSIONS_DRAWN_AHEAD: [u32; 4] = [2, 3, 5, 8];
+
 /// A photon from the emissive shapes, chosen by `u_select`, which is itself
 /// chosen with probability `shape_probability`.
 fn emit_from_shape<C: Radiance>(
