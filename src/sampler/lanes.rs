@@ -75,8 +75,10 @@ pub(super) fn sobol_2d_four(stream_seed: u64, reversed_index: u32, dimensions: [
     let [d0, d1, d2, d3] = dimensions.map(|d| (stream_seed ^ u64::from(d).wrapping_mul(super::DIMENSION_FACTOR)) as i64);
     let dimension_seed = mix64(_mm256_setr_epi64x(d0, d1, d2, d3));
     // The shuffled index (`Sampler::shuffled_index`) in each 64-bit lane's
-    // low half: reversed, Laine–Karras permuted by the seed's low half,
-    // then reversed back.
+    // low half: the reversed sample index Laine–Karras permuted by the
+    // seed's low half, then reversed back. (The high halves, until they
+    // are replaced below, hold values nothing reads: every step before
+    // then works within 32-bit lanes.)
     let shuffled_reversed = laine_karras(_mm256_set1_epi64x(i64::from(reversed_index)), dimension_seed);
     let index = reverse_bits(shuffled_reversed);
     // Sobol' dimension 1 of the index, bit-reversed: its bit k is the parity
