@@ -3,9 +3,11 @@
 //! A scalar 2D draw is a chain of about seventy integer operations: two
 //! SplitMix64 finalisers (the dimension's seed and its scramble), three
 //! Laine–Karras permutations, four table loads and a 64-bit bit reversal.
-//! A path reads its first 2D draws (film position, lens, the first bounces'
-//! light point and direction) at fixed dimensions, so they can be computed
-//! together when the pixel sample starts: the same operations on four
+//! A stream reads its first 2D draws (a path's film position, lens and
+//! first bounces' light point and direction; a photon's point, direction
+//! and first bounces) at fixed dimensions, so they can be computed
+//! together when the stream starts, where that pays (see
+//! `Sampler::draw_ahead`'s callers): the same operations on four
 //! dimensions' values side by side, 64-bit lanes for the finalisers and
 //! 32-bit lanes for the permutations; 117 instructions in the release
 //! build, for what takes about 280 one at a time.
