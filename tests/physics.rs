@@ -90,8 +90,9 @@ fn glass_neither_gains_nor_loses_energy() {
 /// path that leaves the glass sees radiance 1, so its estimate is the
 /// product of Russian roulette's 1/survival alone, at most 1/0.95 per
 /// bounce. Roulette that read the 1/η² compression inside the glass as
-/// lost energy would kill paths there and return the rest with at least
-/// η² = 2.25 (its mean stays 1: `glass_neither_gains_nor_loses_energy`).
+/// lost energy would kill paths there and return the rest heavier, by η =
+/// 1.5 per entry under the square-root rule (its mean stays 1:
+/// `glass_neither_gains_nor_loses_energy`).
 #[test]
 fn roulette_inside_glass_does_not_inflate_the_weights() {
     let loaded = scene(&furnace(GLASS, GLASS_BALL));
@@ -122,6 +123,71 @@ fn roulette_inside_glass_does_not_inflate_the_weights() {
     // near 1, less what depth 8 truncates).
     let mean = sum / n as f64;
     assert!((mean - 1.0).abs() < 0.05, "mean {mean}");
+}
+
+/// An integrating sphere: inside a closed diffuse sphere (radius R, albedo
+/// ρ) a black sphere of radius r and radiance Le sits at the centre. By
+/// symmetry the wall's radiance L is the same everywhere, and a wall point
+/// sees the light over a cone of sin²α = (r/R)² = s of its projected
+/// hemisphere and the wall over the rest, so L = ρ(Le·s + L·(1 − s)), that
+/// is L = ρ·Le·s / (1 − ρ(1 − s)). With ρ = 1/2 half of L comes after the
+/// second bounce, where Russian roulette ends paths and reweights the rest:
+/// a survival rule whose weights do not undo its probabilities moves the
+/// mean.
+#[test]
+fn an_integrating_sphere_matches_its_radiance_balance() {
+    let (albedo, wall_radius, light_radius, emitted) = (0.5, 10.0, 1.0, 100.0);
+    let loaded = scene(&format!(
+        r#"
+[camera]
+position = [0, 0, 4]
+look_at = [0, 0, 10]
+fov_y_degrees = 40
+
+[materials.wall]
+type = "diffuse"
+albedo = [{albedo}, {albedo}, {albedo}]
+
+[materials.light]
+type = "emissive"
+radiance = [{emitted}, {emitted}, {emitted}]
+
+[[objects]]
+type = "sphere"
+center = [0, 0, 0]
+radius = {wall_radius}
+material = "wall"
+
+[[objects]]
+type = "sphere"
+center = [0, 0, 0]
+radius = {light_radius}
+material = "light"
+"#
+    ));
+    let s = (light_radius / wall_radius) * (light_radius / wall_radius);
+    let expected = albedo * emitted * s / (1.0 - albedo * (1.0 - s));
+    let (mean, error) = mean_and_error(
+        &loaded,
+        &Job {
+            width: 16,
+            height: 16,
+            spp: 32,
+            max_depth: 64,
+            ..Job::default()
+        },
+        6,
+    );
+    for c in 0..3 {
+        // Teeth: the estimate is sharp enough to see a 1% bias.
+        assert!(4.0 * error[c] < 0.01 * expected, "estimate too noisy to test: {error:?}");
+        assert!(
+            (mean[c] - expected).abs() < 4.0 * error[c],
+            "channel {c}: mean {} ± {}, expected {expected}",
+            mean[c],
+            error[c]
+        );
+    }
 }
 
 /// Next-event estimation with MIS and pure BSDF sampling estimate the same

@@ -30,7 +30,7 @@
 
 use super::PathTracer;
 use super::diffuse_lanes::{Hits, QuadLight, Shaded, at3, shade};
-use super::tracer::ROULETTE_START;
+use super::tracer::{ROULETTE_START, survival_probability};
 use crate::accel::quad_packets::QuadHit;
 use crate::accel::{Avx2, QuadPackets, RayLanes};
 use crate::color::Color;
@@ -339,7 +339,7 @@ impl RowPaths {
             if bounce + 1 < ROULETTE_START {
                 sampler.skip();
             } else {
-                let survival = throughput.max_element().min(0.95);
+                let survival = survival_probability(throughput.max_element());
                 if sampler.next_1d_independent() >= survival {
                     continue;
                 }

@@ -22,6 +22,22 @@ use glam::DVec2;
 /// Bounces before Russian roulette may end a path.
 pub(super) const ROULETTE_START: u32 = 3;
 
+/// The probability that Russian roulette lets a path go on, from the
+/// largest component of its throughput β: √β, at most 0.95 (Blender
+/// Cycles' rule). Survival in proportion to β itself (Arvo & Kirk 1990)
+/// ends a path whose weight has fallen to β = 1/4 three times in four and
+/// gives the survivors weight 1, so in scenes where light arrives after
+/// many bounces the roulette's variance outgrows the time it saves; with
+/// √β that path survives half the time with weight 1/2. Paths that go on
+/// get no heavier than before (β/√β = √β ≤ 1), so no new fireflies.
+/// Measured on every shipped scene: 3–14% less error per sample for 1–9%
+/// more time per sample (docs/performance.md, "Russian roulette by the
+/// throughput's square root").
+#[inline(always)]
+pub(super) fn survival_probability(largest_throughput: f64) -> f64 {
+    largest_throughput.sqrt().min(0.95)
+}
+
 /// One bounce's draws from the sampler. Every bounce takes the same five
 /// dimensions in the same order (light choice, point on the light, BSDF
 /// direction, BSDF lobe, then the roulette's at the bounce's end), whatever
@@ -314,14 +330,13 @@ impl PathTracer {
                 };
             }
 
-            // Russian roulette: survive with probability ~ throughput, not
-            // counting glass's 1/η² (Veach 1997 §5.2): inside a ball two
-            // thirds of the paths would die for the rest to come out with
-            // 2.25 times the weight.
+            // Russian roulette on the throughput, not counting glass's 1/η²
+            // (Veach 1997 §5.2): inside a ball a third of the paths would die
+            // for the rest to come out with 1.5 times the weight.
             if bounce + 1 < ROULETTE_START {
                 sampler.skip(); // the roulette's dimension, unused
             } else {
-                let survival = (throughput.max_component() * eta_scale).min(0.95);
+                let survival = survival_probability(throughput.max_component() * eta_scale);
                 if sampler.next_1d_independent() >= survival {
                     break;
                 }
