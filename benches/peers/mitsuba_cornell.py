@@ -33,8 +33,8 @@ lights:
 
 Known differences that do not change the expected image but do change noise
 and cost (the equal-time error is the measure that accounts for them):
-Russian roulette (Prism from the 4th segment, survival max(throughput) capped
-at 0.95; Mitsuba's `rr_depth`, default 5, `--rr-depth`), light selection
+Russian roulette (Prism from the 4th segment, survival the square root of
+max(throughput), capped at 0.95; Mitsuba's `rr_depth`, default 5, `--rr-depth`), light selection
 (Prism by power, Mitsuba uniform), the background (Prism finds it only
 through BSDF samples; Mitsuba also samples it as a light, with MIS), and
 samplers (Prism: Owen-scrambled Sobol'; Mitsuba: `--sampler`, default its
