@@ -130,10 +130,12 @@ fn roulette_inside_glass_does_not_inflate_the_weights() {
 /// symmetry the wall's radiance L is the same everywhere, and a wall point
 /// sees the light over a cone of sin²α = (r/R)² = s of its projected
 /// hemisphere and the wall over the rest, so L = ρ(Le·s + L·(1 − s)), that
-/// is L = ρ·Le·s / (1 − ρ(1 − s)). With ρ = 1/2 half of L comes after the
-/// second bounce, where Russian roulette ends paths and reweights the rest:
-/// a survival rule whose weights do not undo its probabilities moves the
-/// mean.
+/// is L = ρ·Le·s / (1 − ρ(1 − s)), the sum over k of the light that reaches
+/// the camera after k reflections between wall points, each a fraction
+/// (ρ(1 − s))^k of the first. With ρ = 1/2 the reflections from the fourth
+/// wall point on, which Russian roulette decides, carry 12% of L: a
+/// survival rule whose weights do not undo its probabilities moves the
+/// mean (weights of 1/q^0.9 moved it by 1.9%, 22 standard errors).
 #[test]
 fn an_integrating_sphere_matches_its_radiance_balance() {
     let (albedo, wall_radius, light_radius, emitted) = (0.5, 10.0, 1.0, 100.0);
