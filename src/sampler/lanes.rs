@@ -10,13 +10,16 @@
 //! `Sampler::draw_ahead`'s callers): the same operations on four
 //! dimensions' values side by side, 64-bit lanes for the finalisers and
 //! 32-bit lanes for the permutations; 117 instructions in the release
-//! build, for what takes about 280 one at a time.
+//! build, for what takes about 280 one at a time. The joint dimension's
+//! lane (`super::JOINT_DIMENSION`) reads the first draw's shuffled index,
+//! computed one by one beside the lanes.
 //!
 //! The results are those of [`super::Sampler::next_2d`] bit for bit: every
 //! step is integer arithmetic modulo 2³² or 2⁶⁴.
 
 /// The Sobol' 2D draws of `dimensions` (each at most
-/// [`super::SOBOL_DIMENSIONS`]) of the stream with `stream_seed` and the
+/// [`super::SOBOL_DIMENSIONS`]; [`super::JOINT_DIMENSION`]'s as the second
+/// half of its four-dimensional point) of the stream with `stream_seed` and the
 /// bit-reversed sample index `reversed_index`, as 32-bit fixed-point
 /// values: x then y of each dimension in turn ([`super::to_unit`] makes
 /// them the draws).
@@ -97,7 +100,19 @@ pub(super) fn sobol_2d_four(stream_seed: u64, reversed_index: u32, dimensions: [
     // (index, second) as the low and high halves of each 64-bit lane, the
     // halves of the scramble (`mix64` of the dimension's seed) beside them.
     let low_halves = _mm256_set1_epi64x(0xffff_ffff);
-    let pairs = _mm256_or_si256(_mm256_and_si256(index, low_halves), _mm256_slli_epi64::<32>(second));
+    let mut pairs = _mm256_or_si256(_mm256_and_si256(index, low_halves), _mm256_slli_epi64::<32>(second));
+    // The joint dimension's lane (if any) takes Sobol' dimensions 3 and 4
+    // of the index shuffled for the first draw instead: computed one by one
+    // beside the lanes' chain, which it joins only here.
+    if let Some(lane) = dimensions.iter().position(|&d| d == super::JOINT_DIMENSION) {
+        let first_seed = super::mix64(stream_seed ^ u64::from(super::FIRST_DIMENSION).wrapping_mul(super::DIMENSION_FACTOR));
+        let shuffled = super::laine_karras_permutation(reversed_index, first_seed as u32);
+        let (first_draws_index, _) = super::index_and_second_dimension(shuffled);
+        let (third, fourth) = super::joint::third_and_fourth_reversed(first_draws_index);
+        let joint = _mm256_set1_epi64x((u64::from(third) | u64::from(fourth) << 32) as i64);
+        let in_lane = _mm256_cmpeq_epi64(_mm256_setr_epi64x(0, 1, 2, 3), _mm256_set1_epi64x(lane as i64));
+        pairs = _mm256_blendv_epi8(pairs, joint, in_lane);
+    }
     let points = reverse_bits(laine_karras(pairs, mix64(dimension_seed)));
     bytemuck::cast(points)
 }

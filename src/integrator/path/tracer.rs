@@ -45,7 +45,10 @@ pub(super) fn survival_probability(largest_throughput: f64) -> f64 {
 /// the top of the bounce, where their hash chains (tens of dependent
 /// multiplications) overlap the ray's traversal instead of following it.
 /// The two 2D draws, which nearly every surface reads, are computed then;
-/// the 1D draws only where read ([`Sampler::defer_1d`]).
+/// the 1D draws only where read ([`Sampler::defer_1d`]). The first
+/// bounce's point on the light is the sampler's joint dimension: one
+/// four-dimensional Sobol' point with the film position
+/// ([`crate::sampler::JOINT_DIMENSION`]).
 struct BounceDraws {
     /// `None` with one light or none: nothing to choose.
     light_choice: Option<Deferred1d>,
