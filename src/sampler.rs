@@ -66,10 +66,11 @@ pub const FIRST_DIMENSION: u32 = 1;
 
 /// The dimension whose 2D draw completes a four-dimensional Sobol' point
 /// with the draw at [`FIRST_DIMENSION`]: in a camera path, the first
-/// surface's light sample (after the lens and the light's choice). Its
-/// error falls by 5–10% on scenes whose pixels straddle penumbrae and
-/// shading changes, and by nothing measurable elsewhere (docs/performance.md,
-/// "The film position and the first light sample as one Sobol' point").
+/// surface's light sample (after the lens and the light's choice). The
+/// squared error at equal samples falls by 5–10% on scenes whose pixels
+/// straddle penumbrae and shading changes (the bunny, earth), and by
+/// nothing measurable elsewhere (docs/performance.md, "The film position
+/// and the first light sample as one Sobol' point").
 /// A 1D draw there is an ordinary one.
 pub const JOINT_DIMENSION: u32 = 4;
 
@@ -212,10 +213,11 @@ impl Sampler {
         let dimension_seed = self.dimension_seed(self.dimension);
         match self.kind {
             SamplerKind::Sobol if self.dimension <= SOBOL_DIMENSIONS => {
-                // Sobol' dimensions 0 (reverse(index)) and 1 of the index
-                // shuffled for this dimension, or at the joint dimension
-                // dimensions 2 and 3 of the index shuffled for the first
-                // draw, each bit-reversed ...
+                // The first two Sobol' dimensions (van der Corput, which is
+                // reverse(index), and x + 1) of the index shuffled for this
+                // dimension, or at the joint dimension the next two (Joe &
+                // Kuo's 3 and 4) of the index shuffled for the first draw,
+                // each bit-reversed ...
                 let (x, y) = if self.dimension == JOINT_DIMENSION {
                     self.joint_dimensions_reversed()
                 } else {
@@ -240,11 +242,10 @@ impl Sampler {
         }
     }
 
-    /// Sobol' dimensions 2 and 3 of the index shuffled for the first draw,
-    /// bit-reversed: the joint dimension's draw before its scramble. Out of
-    /// line: read once per stream, it would otherwise be compiled into
-    /// every 2D draw of every loop (the diffuse kernel's rows, which take it
-    /// from the lanes, ran 3–5% slower so).
+    /// Sobol' dimensions 3 and 4 (Joe & Kuo's numbering) of the index
+    /// shuffled for the first draw, bit-reversed: the joint dimension's draw
+    /// before its scramble. Out of line: read at most once per stream, it
+    /// need not be compiled into every 2D draw of every loop.
     #[inline(never)]
     fn joint_dimensions_reversed(&self) -> (u32, u32) {
         let (first_draws_index, _) = self.shuffled_index(self.dimension_seed(FIRST_DIMENSION) as u32);
@@ -485,7 +486,6 @@ mod tests {
                 joint * factor < separate,
                 "{name}: joint {joint:.3e}, separate {separate:.3e}"
             );
-            eprintln!("{name}: joint {joint:.3e}, separate {separate:.3e}");
         }
     }
 
