@@ -309,20 +309,40 @@ fn to_unit(bits: u32) -> f64 {
 /// it: a byte swap and three rounds of masks and shifts).
 #[inline]
 fn index_and_second_dimension(reversed: u32) -> (u32, u32) {
-    let t = &INDEX_AND_SECOND_DIMENSION;
-    let both = t[0][(reversed & 0xff) as usize]
-        ^ t[1][((reversed >> 8) & 0xff) as usize]
-        ^ t[2][((reversed >> 16) & 0xff) as usize]
-        ^ t[3][(reversed >> 24) as usize];
+    let both = xor_of_byte_tables(&INDEX_AND_SECOND_DIMENSION, reversed);
     (both as u32, (both >> 32) as u32)
 }
 
+/// A map of 32 bits that is linear over XOR, read from one table per byte
+/// (`tables[k]` maps byte k): the XOR of the four bytes' entries.
+#[inline]
+fn xor_of_byte_tables(tables: &[[u64; 256]; 4], bits: u32) -> u64 {
+    tables[0][(bits & 0xff) as usize]
+        ^ tables[1][((bits >> 8) & 0xff) as usize]
+        ^ tables[2][((bits >> 16) & 0xff) as usize]
+        ^ tables[3][(bits >> 24) as usize]
+}
+
+/// The Sobol' dimension with direction numbers `directions` (v₁…v₃₂) of
+/// `index`: the XOR of vⱼ over the set bits j of the index.
+const fn sobol(index: u32, directions: &[u32; 32]) -> u32 {
+    let mut value = 0;
+    let mut bit = 0;
+    while bit < 32 {
+        if index & (1 << bit) != 0 {
+            value ^= directions[bit];
+        }
+        bit += 1;
+    }
+    value
+}
+
 const INDEX_AND_SECOND_DIMENSION: [[u64; 256]; 4] = {
-    let mut directions_reversed = [0u32; 32];
+    let mut directions = [0u32; 32];
     let mut v = 1u32 << 31;
     let mut j = 0;
     while j < 32 {
-        directions_reversed[j] = v.reverse_bits();
+        directions[j] = v;
         v ^= v >> 1;
         j += 1;
     }
@@ -332,14 +352,7 @@ const INDEX_AND_SECOND_DIMENSION: [[u64; 256]; 4] = {
         let mut value = 0;
         while value < 256 {
             let index = ((value as u32) << (8 * byte)).reverse_bits();
-            let mut second = 0;
-            let mut bit = 0;
-            while bit < 32 {
-                if index & (1 << bit) != 0 {
-                    second ^= directions_reversed[bit];
-                }
-                bit += 1;
-            }
+            let second = sobol(index, &directions).reverse_bits();
             tables[byte][value] = index as u64 | (second as u64) << 32;
             value += 1;
         }

@@ -54,23 +54,11 @@ const fn direction_numbers(degree: usize, coefficients: u32, initial: &[u32]) ->
     directions
 }
 
+use super::sobol;
+
 /// Joe & Kuo's dimension 3 (x² + x + 1; m = 1, 3) and 4 (x³ + x + 1; m = 1, 3, 1).
 const THIRD: [u32; 32] = direction_numbers(2, 1, &[1, 3]);
 const FOURTH: [u32; 32] = direction_numbers(3, 1, &[1, 3, 1]);
-
-/// Sobol' dimension `directions` of `index`: the XOR of vⱼ over the set
-/// bits j of the index (natural order, as the first two dimensions).
-const fn sobol(index: u32, directions: &[u32; 32]) -> u32 {
-    let mut value = 0;
-    let mut bit = 0;
-    while bit < 32 {
-        if index & (1 << bit) != 0 {
-            value ^= directions[bit];
-        }
-        bit += 1;
-    }
-    value
-}
 
 /// Per byte of the index: dimension 3 bit-reversed in the low half,
 /// dimension 4 bit-reversed in the high half.
@@ -95,11 +83,7 @@ const THIRD_AND_FOURTH: [[u64; 256]; 4] = {
 /// Laine–Karras permutation of an Owen scramble takes).
 #[inline]
 pub(super) fn third_and_fourth_reversed(index: u32) -> (u32, u32) {
-    let t = &THIRD_AND_FOURTH;
-    let both = t[0][(index & 0xff) as usize]
-        ^ t[1][((index >> 8) & 0xff) as usize]
-        ^ t[2][((index >> 16) & 0xff) as usize]
-        ^ t[3][(index >> 24) as usize];
+    let both = super::xor_of_byte_tables(&THIRD_AND_FOURTH, index);
     (both as u32, (both >> 32) as u32)
 }
 
