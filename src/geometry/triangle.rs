@@ -49,6 +49,10 @@ pub struct TriangleRay {
 impl TriangleRay {
     /// The per-ray permutation and shear of the watertight test (Woop et al.
     /// 2013, §3): the axis of the direction's largest magnitude becomes z.
+    // Always inlined: made at a ray's first triangle leaf, inside the
+    // traversal, where an out-of-line call spilled the traversal's registers
+    // (measured: incoherent rays 3–5% faster on the 3.7k and 59k bunnies).
+    #[inline(always)]
     pub fn new(ray: &Ray) -> Self {
         let d = ray.direction;
         let kz = d.abs().max_position();
