@@ -46,9 +46,12 @@ impl Light {
 /// A point chosen on a light, seen from a reference point.
 #[derive(Clone, Copy, Debug)]
 pub struct LightSample<'a> {
-    /// Unit direction from the reference point to the light point.
+    /// Direction from the reference point to the light point:
+    /// (`point` − reference) / `distance`, unit to within `point_error`
+    /// over `distance`.
     pub wi: DVec3,
-    /// Distance from the reference point to `point`.
+    /// Distance from the reference point to `point` (to within
+    /// `point_error`); a ray along `wi` reaches `point` at t = `distance`.
     pub distance: f64,
     /// The chosen point on the light, world space.
     pub point: DVec3,

@@ -14,7 +14,9 @@ pub struct ShapeSample {
     pub point_error: DVec3,
     /// Unit outward normal at `point`.
     pub normal: DVec3,
-    /// |`point` − the reference point|.
+    /// |`point` − the reference point|, to within `point_error` (a sphere
+    /// gives the distance along its sampled direction). A ray aimed along
+    /// (`point` − reference) / `distance` reaches `point` at t = `distance`.
     pub distance: f64,
     /// Density per unit solid angle at the reference point.
     pub pdf: f64,

@@ -273,9 +273,11 @@ impl PathTracer {
                     let wi = frame.to_local(light.wi);
                     let f = material.eval(wo, wi, &at) * wi.z.abs();
                     if f != Color::ZERO {
-                        // The light sample's direction is unit already: normalising
-                        // it again (`Ray::spawn`) would put a square root and a
-                        // division between the sample and the shadow ray's traversal.
+                        // The light sample's direction is unit already (to within the
+                        // point's error over its distance): normalising it again
+                        // (`Ray::spawn`) would put a square root and a division
+                        // between the sample and the shadow ray's traversal, and
+                        // along it the point lies at t = `light.distance`.
                         let shadow = Ray {
                             origin: offset_ray_origin(hit.point, hit.point_error, hit.geometric_normal, light.wi),
                             direction: light.wi,
