@@ -157,8 +157,8 @@ impl Sphere {
         // h > d/4. Nearer the sphere, where d cos θ and the half chord
         // cancel in h, the point's measured distance is taken. Taking h
         // spares the square root and the division after it that made the
-        // light sample wait for its point (caustic.toml 7% less time per
-        // sample). A shadow ray aimed along (point − reference)/distance, as
+        // light sample wait for its point (caustic.toml 4–5% less time per
+        // sample, docs/performance.md). A shadow ray aimed along (point − reference)/distance, as
         // the path tracer's is, reaches the point at t = distance whatever
         // the rounding, so a segment ending short of that t ends short of
         // the point.
@@ -264,9 +264,10 @@ mod tests {
 
     /// A light sample's distance is its point's, to within the point's error
     /// bound, for references from 10⁻³ to 10⁴ radii off the surface (spheres
-    /// of radius 10⁻² to 10² up to 170 units out); and a shadow segment built as the path tracer builds it (towards the
-    /// point, stopped 10⁻⁹ of the distance and the point's error short)
-    /// never reaches the sphere it is aimed at.
+    /// of radius 10⁻² to 10² up to 170 units out); and a shadow segment
+    /// built as the path tracer builds it (towards the point, stopped 10⁻⁹
+    /// of the distance and the point's error short) never reaches the
+    /// sphere it is aimed at.
     #[test]
     fn sampled_distances_are_the_points_and_shadow_segments_stop_short() {
         let mut state = 7u64;
