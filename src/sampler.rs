@@ -248,8 +248,7 @@ impl Sampler {
     /// need not be compiled into every 2D draw of every loop.
     #[inline(never)]
     fn joint_dimensions_reversed(&self) -> (u32, u32) {
-        let (first_draws_index, _) = self.shuffled_index(self.dimension_seed(FIRST_DIMENSION) as u32);
-        joint::third_and_fourth_reversed(first_draws_index)
+        joint_dimensions_reversed(self.stream_seed, self.reversed_index)
     }
 
     /// Passes over one draw (1D or 2D) without computing it, for a value
@@ -291,8 +290,25 @@ impl Sampler {
 
     #[inline]
     fn dimension_seed(&self, dimension: u32) -> u64 {
-        mix64(self.stream_seed ^ (dimension as u64).wrapping_mul(DIMENSION_FACTOR))
+        dimension_seed(self.stream_seed, dimension)
     }
+}
+
+/// The seed of `dimension` in the stream with `stream_seed`.
+#[inline]
+fn dimension_seed(stream_seed: u64, dimension: u32) -> u64 {
+    mix64(stream_seed ^ (dimension as u64).wrapping_mul(DIMENSION_FACTOR))
+}
+
+/// Sobol' dimensions 3 and 4 (Joe & Kuo's numbering), bit-reversed, of the
+/// index shuffled for the first draw of the stream with `stream_seed`, at
+/// the bit-reversed sample index `reversed_index`: the joint dimension's
+/// draw before its scramble, for [`Sampler`] and its four-lane draws alike.
+#[inline]
+fn joint_dimensions_reversed(stream_seed: u64, reversed_index: u32) -> (u32, u32) {
+    let first_seed = dimension_seed(stream_seed, FIRST_DIMENSION) as u32;
+    let (first_draws_index, _) = index_and_second_dimension(laine_karras_permutation(reversed_index, first_seed));
+    joint::third_and_fourth_reversed(first_draws_index)
 }
 
 /// 32 random bits to a float in [0, 1), never 1.

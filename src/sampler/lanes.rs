@@ -105,10 +105,7 @@ pub(super) fn sobol_2d_four(stream_seed: u64, reversed_index: u32, dimensions: [
     // of the index shuffled for the first draw instead: computed one by one
     // beside the lanes' chain, which it joins only here.
     if let Some(lane) = dimensions.iter().position(|&d| d == super::JOINT_DIMENSION) {
-        let first_seed = super::mix64(stream_seed ^ u64::from(super::FIRST_DIMENSION).wrapping_mul(super::DIMENSION_FACTOR));
-        let shuffled = super::laine_karras_permutation(reversed_index, first_seed as u32);
-        let (first_draws_index, _) = super::index_and_second_dimension(shuffled);
-        let (third, fourth) = super::joint::third_and_fourth_reversed(first_draws_index);
+        let (third, fourth) = super::joint_dimensions_reversed(stream_seed, reversed_index);
         let joint = _mm256_set1_epi64x((u64::from(third) | u64::from(fourth) << 32) as i64);
         let in_lane = _mm256_cmpeq_epi64(_mm256_setr_epi64x(0, 1, 2, 3), _mm256_set1_epi64x(lane as i64));
         pairs = _mm256_blendv_epi8(pairs, joint, in_lane);
