@@ -130,11 +130,20 @@ impl BallOptics {
         };
         let step = (MAX_IMPACT - first) / samples as f64;
         let mut low = first;
-        let (mut low_miss, _) = miss(low);
+        let (mut low_miss, mut low_ahead) = miss(low);
         for i in 1..=samples {
             let high = first + step * i as f64;
-            let (high_miss, _) = miss(high);
-            if (low_miss < 0.0) != (high_miss < 0.0) {
+            let (high_miss, high_ahead) = miss(high);
+            // A sign change in a narrow bracket of the scan through the ball
+            // where y lies behind the exit point at both ends is a line
+            // through y that light would have to travel backwards: not
+            // refined (most of a glass ball's brackets under a light above
+            // it). Only a bracket in which `ahead` changed sign twice could
+            // hide a path this way; as for every path the scan misses, BSDF
+            // sampling then keeps it (see the module notes). The mirror's one
+            // bracket spans every impact, so its root is always refined.
+            let behind = bounce == Bounce::Through && low_ahead <= 0.0 && high_ahead <= 0.0;
+            if (low_miss < 0.0) != (high_miss < 0.0) && !behind {
                 let impact = refine(&miss, (low, low_miss), (high, high_miss));
                 let (_, ahead) = miss(impact);
                 if ahead > 0.0 && !paths.is_full() {
@@ -142,7 +151,7 @@ impl BallOptics {
                     paths.push(plane.lift(self.center, planar, impact));
                 }
             }
-            (low, low_miss) = (high, high_miss);
+            (low, low_miss, low_ahead) = (high, high_miss, high_ahead);
         }
         paths
     }
