@@ -86,6 +86,10 @@ struct Plane {
     across: DVec3,
     /// Distance of x from the centre.
     x_distance: f64,
+    /// The radius over that distance: sin α = impact · this (see
+    /// [`BallOptics::planar_path`]), a product where a division would sit
+    /// on every evaluation of the scan and the refinement.
+    aim_scale: f64,
     /// y in the plane's coordinates.
     y: DVec2,
 }
@@ -114,7 +118,7 @@ impl BallOptics {
         // component of the way to y), and whether ahead of the exit point
         // (negative: behind it, not a path).
         let miss = |impact: f64| {
-            let path = self.planar_path(bounce, plane.x_distance, impact);
+            let path = self.planar_path(bounce, plane.aim_scale, impact);
             let to_y = plane.y - path.exit;
             (path.exit_direction.perp_dot(to_y), path.exit_direction.dot(to_y))
         };
@@ -147,7 +151,7 @@ impl BallOptics {
                 let impact = refine(&miss, (low, low_miss), (high, high_miss));
                 let (_, ahead) = miss(impact);
                 if ahead > 0.0 && !paths.is_full() {
-                    let planar = self.planar_path(bounce, plane.x_distance, impact);
+                    let planar = self.planar_path(bounce, plane.aim_scale, impact);
                     paths.push(plane.lift(self.center, planar, impact));
                 }
             }
@@ -212,7 +216,8 @@ impl BallOptics {
         if bounce == Bounce::Off {
             return Some((entry, reflect(direction, normal, cos_incidence)));
         }
-        let (inside, cos_inside) = refract_in(direction, normal, cos_incidence, self.ior);
+        let sin2_incidence = 1.0 - cos_incidence * cos_incidence;
+        let (inside, cos_inside) = refract_in(direction, normal, cos_incidence, sin2_incidence, self.ior.recip());
         let exit = entry + inside * (2.0 * self.radius * cos_inside);
         let exit_normal = (exit - self.center) / self.radius;
         Some((exit, refract_out(inside, exit_normal, cos_inside, cos_incidence, self.ior)))
@@ -236,6 +241,7 @@ impl BallOptics {
             towards_x,
             across,
             x_distance,
+            aim_scale: self.radius / x_distance,
             y: DVec2::new(to_y.dot(towards_x), off),
         })
     }
@@ -245,10 +251,20 @@ impl BallOptics {
     /// the angle of incidence (sin θ = impact) and α the ray's angle to the
     /// line from x to the centre (sin α = R sin θ / |x|), the ray meets the
     /// circle at polar angle θ − α: the triangle x, centre, entry.
-    fn planar_path(&self, bounce: Bounce, x_distance: f64, impact: f64) -> PlanarPath {
+    /// `aim_scale` is R / |x|.
+    ///
+    /// The root scan and its refinement evaluate this a few dozen times per
+    /// connection, each step of the refinement waiting on the one before,
+    /// so its chain of dependent operations is kept short: sin²θ is the
+    /// impact squared rather than 1 − cos²θ (so Snell's law does not wait
+    /// for cos θ's square root), and the divisions by R, |x| and η are
+    /// products with reciprocals that do not depend on the impact (R/|x|
+    /// made once per pair of points).
+    fn planar_path(&self, bounce: Bounce, aim_scale: f64, impact: f64) -> PlanarPath {
         let radius = self.radius;
-        let cos_incidence = (1.0 - impact * impact).sqrt();
-        let sin_aim = radius * impact / x_distance;
+        let sin2_incidence = impact * impact;
+        let cos_incidence = (1.0 - sin2_incidence).sqrt();
+        let sin_aim = impact * aim_scale;
         let cos_aim = (1.0 - sin_aim * sin_aim).sqrt();
         let entry_normal = DVec2::new(
             cos_incidence * cos_aim + impact * sin_aim,
@@ -265,9 +281,9 @@ impl BallOptics {
                 cos_incidence,
             };
         }
-        let (inside, cos_inside) = refract_in(direction, entry_normal, cos_incidence, self.ior);
+        let (inside, cos_inside) = refract_in(direction, entry_normal, cos_incidence, sin2_incidence, self.ior.recip());
         let exit = entry + inside * (2.0 * radius * cos_inside);
-        let exit_direction = refract_out(inside, exit / radius, cos_inside, cos_incidence, self.ior);
+        let exit_direction = refract_out(inside, exit * radius.recip(), cos_inside, cos_incidence, self.ior);
         PlanarPath {
             direction,
             entry,
@@ -305,12 +321,13 @@ fn reflect<V: Vector>(direction: V, normal: V, cos_incidence: f64) -> V {
 
 /// Snell's law entering the ball (pbrt-v4 eq. 9.4 with η = `ior`): the
 /// direction inside and the cosine of its angle to the inward normal.
-/// `normal` is the outward normal, `cos_incidence` = −direction · normal.
-fn refract_in<V: Vector>(direction: V, normal: V, cos_incidence: f64, ior: f64) -> (V, f64) {
-    let sin2_inside = (1.0 - cos_incidence * cos_incidence) / (ior * ior);
+/// `normal` is the outward normal, `cos_incidence` = −direction · normal,
+/// `sin2_incidence` = 1 − cos², `inverse_ior` = 1/η.
+fn refract_in<V: Vector>(direction: V, normal: V, cos_incidence: f64, sin2_incidence: f64, inverse_ior: f64) -> (V, f64) {
+    let sin2_inside = sin2_incidence * (inverse_ior * inverse_ior);
     let cos_inside = (1.0 - sin2_inside).max(0.0).sqrt();
     (
-        direction * (1.0 / ior) + normal * (cos_incidence / ior - cos_inside),
+        direction * inverse_ior + normal * (cos_incidence * inverse_ior - cos_inside),
         cos_inside,
     )
 }
@@ -455,7 +472,7 @@ mod tests {
                 let mut previous = None;
                 for k in 0..=n {
                     let impact = -MAX_IMPACT + 2.0 * MAX_IMPACT * k as f64 / n as f64;
-                    let path = ball.planar_path(bounce, plane.x_distance, impact);
+                    let path = ball.planar_path(bounce, plane.aim_scale, impact);
                     let to_y = plane.y - path.exit;
                     let side = path.exit_direction.perp_dot(to_y) < 0.0;
                     let ahead = path.exit_direction.dot(to_y) > 0.0;
