@@ -37,6 +37,10 @@ const MAX_IMPACT: f64 = 1.0 - 1e-4;
 /// this are all but certain).
 const SAME_PATH: f64 = 1e-7;
 
+/// Relative margin of [`BallOptics::hidden_behind_tangent_plane`], far
+/// above the rounding of the paths' exit directions.
+const TANGENT_PLANE_MARGIN: f64 = 1e-3;
+
 /// A smooth sphere, as a lens or a convex mirror.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BallOptics {
@@ -158,6 +162,16 @@ impl BallOptics {
             (low, low_miss, low_ahead) = (high, high_miss, high_ahead);
         }
         paths
+    }
+
+    /// Whether the whole ball lies behind the tangent plane at the point `y`
+    /// of a surface with unit normal `normal`: n · (c − y) < −R, with a
+    /// margin. Then every exit point e has n · (e − y) < 0, so no path from
+    /// the ball reaches y from the side `normal` faces (a one-sided light's
+    /// point there receives none, whatever x), and the root search can be
+    /// skipped.
+    pub fn hidden_behind_tangent_plane(&self, y: DVec3, normal: DVec3) -> bool {
+        normal.dot(self.center - y) < -self.radius * (1.0 + TANGENT_PLANE_MARGIN)
     }
 
     /// Whether [`paths`](Self::paths) from `x` to `y` includes the one
@@ -444,6 +458,41 @@ mod tests {
             }
             assert!(found > 300, "{bounce:?}: only {found} paths");
         }
+    }
+
+    /// No path reaches the front of a point whose tangent plane has the
+    /// ball behind it; and the test is not looser than it need be: points
+    /// whose tangent plane cuts the ball (−R < n · (c − y) < 0) do receive
+    /// paths from the front.
+    #[test]
+    fn no_path_reaches_the_front_of_a_point_whose_tangent_plane_hides_the_ball() {
+        let ball = ball();
+        let (mut hidden, mut cut_and_reached) = (0, 0);
+        for bounce in [Bounce::Through, Bounce::Off] {
+            for (i, (x, y)) in point_pairs(&ball, bounce).enumerate() {
+                let paths = ball.paths(bounce, x, y);
+                for k in 0..24 {
+                    // Normals spread over the sphere (a golden-angle spiral).
+                    let z = 1.0 - (2 * k + 1) as f64 / 24.0;
+                    let azimuth = 2.399_963 * (k + i) as f64;
+                    let radial = (1.0 - z * z).sqrt();
+                    let normal = DVec3::new(radial * azimuth.cos(), radial * azimuth.sin(), z);
+                    for path in &paths {
+                        let from_front = normal.dot(-path.exit_direction) > 0.0;
+                        if ball.hidden_behind_tangent_plane(y, normal) {
+                            hidden += 1;
+                            assert!(!from_front, "{bounce:?}: a path reaches the front of {y} (normal {normal})");
+                        } else if from_front && normal.dot(ball.center - y) < 0.0 {
+                            cut_and_reached += 1;
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            hidden > 1000 && cut_and_reached > 100,
+            "{hidden} hidden, {cut_and_reached} cut and reached"
+        );
     }
 
     /// Behind a ball lit from far away, points near the axis between the

@@ -61,6 +61,12 @@ pub fn radiance_by_balls<C: Radiance>(
             continue;
         };
         let y = sample.point;
+        // A one-sided light's point that no path from the ball reaches from
+        // the front (most often on the far side of a sphere light): every
+        // path the search found would fail `towards_ball` below.
+        if !light.two_sided && ball.optics.hidden_behind_tangent_plane(y, sample.normal) {
+            continue;
+        }
         let area_pdf = selection / area;
         for path in ball.optics.paths(ball.bounce, hit.point, y) {
             let towards_ball = sample.normal.dot(-path.exit_direction) > 0.0;
