@@ -149,7 +149,8 @@ impl BallOptics {
             // it). Only a bracket in which `ahead` changed sign twice could
             // hide a path this way; as for every path the scan misses, BSDF
             // sampling then keeps it (see the module notes). The mirror's one
-            // bracket spans every impact, so its root is always refined.
+            // bracket spans every impact a reflection towards y can have, so
+            // its root is always refined.
             let behind = bounce == Bounce::Through && low_ahead <= 0.0 && high_ahead <= 0.0;
             if (low_miss < 0.0) != (high_miss < 0.0) && !behind {
                 let impact = refine(&miss, (low, low_miss), (high, high_miss));
