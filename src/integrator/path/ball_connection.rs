@@ -61,12 +61,6 @@ pub fn radiance_by_balls<C: Radiance>(
             continue;
         };
         let y = sample.point;
-        // A one-sided light's point that no path from the ball reaches from
-        // the front (most often on the far side of a sphere light): every
-        // path the search found would fail `towards_ball` below.
-        if !light.two_sided && ball.optics.hidden_behind_tangent_plane(y, sample.normal) {
-            continue;
-        }
         let area_pdf = selection / area;
         for path in ball.optics.paths(ball.bounce, hit.point, y) {
             let towards_ball = sample.normal.dot(-path.exit_direction) > 0.0;
@@ -107,7 +101,9 @@ pub fn radiance_by_balls<C: Radiance>(
 /// cut by opaque spheres, the cap on the ball's side of each (a straight
 /// leg from the ball crosses none of them, so it ends there: smallpt's
 /// light, whose whole sphere is 4400 times the sliver below its ceiling);
-/// otherwise the whole surface. `None` if the area is degenerate.
+/// otherwise the whole surface. `None` if the area is degenerate, or if
+/// the point drawn faces away from the whole ball (it then receives nothing
+/// from it: the draw counts as zero).
 pub(super) fn light_point_seen_by(light: &Light, emitter: &Emitter, ball: &SpecularBall, u: DVec2) -> Option<(AreaSample, f64)> {
     let cap = light
         .clipped
@@ -117,7 +113,12 @@ pub(super) fn light_point_seen_by(light: &Light, emitter: &Emitter, ball: &Specu
         Some((clipped, (cap, area))) => (clipped.sample_cap(&cap, u), area),
         None => (emitter.sample_area(u), emitter.area()),
     };
-    (area > 0.0 && area.is_finite()).then_some((sample, area))
+    // A one-sided light's point that no path from the ball reaches from the
+    // front (most often on the far side of a sphere light): every path the
+    // root search found there would fail the callers' `towards_ball` test,
+    // so the search is not run.
+    let hidden = !light.two_sided && ball.optics.hidden_behind_tangent_plane(sample.point, sample.normal);
+    (area > 0.0 && area.is_finite() && !hidden).then_some((sample, area))
 }
 
 /// Whether nothing blocks the legs of `path`: `to_ball` (a ray along

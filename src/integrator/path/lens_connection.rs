@@ -219,11 +219,6 @@ impl LensView {
             return;
         };
         let (x, y) = (self.camera.lens_point(lens), light_point.point);
-        // As in `radiance_by_balls`: no path from the ball reaches this
-        // point from the front, so each would fail `towards_ball` below.
-        if !light.two_sided && ball.optics.hidden_behind_tangent_plane(y, light_point.normal) {
-            return;
-        }
         let area_pdf = selection / area;
         for path in ball.optics.paths(Bounce::Off, x, y) {
             let towards_ball = light_point.normal.dot(-path.exit_direction) > 0.0;
