@@ -24,6 +24,9 @@ pub struct SphereCap {
     pub axis: DVec3,
     /// 1 − cos of the cap's angular radius about the sphere's centre, in [0, 2].
     pub versine: f64,
+    /// A basis about `axis`, made once: every light sample maps its normal
+    /// through it, and making it takes a division.
+    frame: Frame,
 }
 
 impl SphereCap {
@@ -42,16 +45,16 @@ impl SphereCap {
         let denominator = 2.0 * big_r * d;
         let versine_inside = ((r - d + big_r) * (r + d - big_r) / denominator).clamp(0.0, 2.0);
         let versine_outside = ((big_r + d - r) * (big_r + d + r) / denominator).clamp(0.0, 2.0);
-        Some((
-            Self {
-                axis,
-                versine: versine_inside,
-            },
-            Self {
-                axis: -axis,
-                versine: versine_outside,
-            },
-        ))
+        Some((Self::new(axis, versine_inside), Self::new(-axis, versine_outside)))
+    }
+
+    /// The cap of normals within acos(1 − `versine`) of the unit `axis`.
+    pub fn new(axis: DVec3, versine: f64) -> Self {
+        Self {
+            axis,
+            versine,
+            frame: Frame::from_normal(axis),
+        }
     }
 
     /// Area of the cap on a sphere of radius `radius`: 2π R² (1 − cos α).
@@ -74,7 +77,7 @@ impl SphereCap {
         let sin_theta = (versine * (2.0 - versine)).max(0.0).sqrt();
         let (cos_phi, sin_phi) = cos_sin_turns(u.y);
         let local = DVec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta);
-        Frame::from_normal(self.axis).to_world(local).normalize()
+        self.frame.to_world(local).normalize()
     }
 }
 
@@ -127,10 +130,7 @@ mod tests {
     /// is the cap's centroid, 1 − versine / 2, as uniform area requires.
     #[test]
     fn sampled_normals_fill_the_cap_uniformly_in_cos_theta() {
-        let cap = SphereCap {
-            axis: DVec3::new(0.3, -0.8, 0.2).normalize(),
-            versine: 0.4,
-        };
+        let cap = SphereCap::new(DVec3::new(0.3, -0.8, 0.2).normalize(), 0.4);
         let n = 64;
         let mut sum = 0.0;
         for i in 0..n {
