@@ -11,7 +11,10 @@
 //! exactly when it fits one block of its kind; no SAH is evaluated for it.
 //! The exception is a kind whose block costs more than a traversal step
 //! (four spheres tested at once): a range of it that fits one block is
-//! still split when the SAH says rays would skip enough of it. Leaves never
+//! still split when the SAH says rays would skip enough of it, and its
+//! small ranges are split by the best of all partitions, not only of
+//! centroid planes (spheres' boxes may overlap so that no plane separates
+//! them well). Leaves never
 //! mix primitive kinds (triangles and other shapes are stored apart), and
 //! subtrees deeper than [`MAX_SAH_DEPTH`] fall back to median splits, which
 //! bounds the depth for any input.
@@ -29,6 +32,7 @@
 //! double-precision boxes, so a box can only be larger than what it holds.
 
 use super::bounds::Bounds32;
+use arrayvec::ArrayVec;
 use wide::{CmpGt, CmpLt, f32x4, i32x4};
 
 /// Bins per axis: 16 is within a few per cent of a full sweep's quality.
@@ -314,7 +318,13 @@ fn choose_split(items: &mut [BuildItem], range: &Range, kinds: &[LeafKind]) -> O
             return split_costly_block(items, range, leaf_kind(first_kind, kinds));
         }
     }
-    // From here on the range must be split.
+    // From here on the range must be split: a small one of a costly kind
+    // as its cheapest partition, the rest at the cheapest centroid plane.
+    let kind = leaf_kind(items[0].kind(), kinds);
+    if count <= EXHAUSTIVE_MAX && kind.block_cost > TRAVERSAL_COST && items.iter().all(|i| i.kind() == items[0].kind()) {
+        let (_, left_set) = cheapest_partition(items, kind);
+        return Some(split_by_set(items, range, left_set));
+    }
     let extent = range.centroids.extent();
     if range.depth >= MAX_SAH_DEPTH || extent.iter().all(|&e| e <= 0.0) {
         // No plane separates the centroids, or the tree is already deep:
@@ -336,17 +346,60 @@ fn choose_split(items: &mut [BuildItem], range: &Range, kinds: &[LeafKind]) -> O
 /// boxes, cost less than the block every ray entering the range would
 /// test: C_trav · A + C_block · (A_L + A_R) < C_block · A.
 fn split_costly_block(items: &mut [BuildItem], range: &Range, kind: LeafKind) -> Option<(usize, Range, Range)> {
-    let extent = range.centroids.extent();
-    if kind.block_cost <= TRAVERSAL_COST || items.len() < 2 || extent.iter().all(|&e| e <= 0.0) {
+    if kind.block_cost <= TRAVERSAL_COST || items.len() < 2 {
         return None;
     }
-    let binning = Binning::new(range, extent);
-    let bins = binning.bin(items);
-    let block_shift = kind.max_size.clamp(1, MAX_LEAF_SIZE).ilog2();
-    let (axis, plane, split_areas) = bins.cheapest_plane(items.len(), block_shift)?;
+    let (split_areas, left_set) = cheapest_partition(items, kind);
     let area = range.bounds.half_area();
-    (TRAVERSAL_COST * area + kind.block_cost * split_areas < kind.block_cost * area)
-        .then(|| partition(items, range, |item| binning.bins_of(item)[axis] < plane as i32))
+    (TRAVERSAL_COST * area + kind.block_cost * split_areas < kind.block_cost * area).then(|| split_by_set(items, range, left_set))
+}
+
+/// Most items of a costly kind whose split is chosen among all partitions
+/// into two sets ([`cheapest_partition`]): 2⁸ of them at most, a few
+/// microseconds.
+const EXHAUSTIVE_MAX: usize = 2 * MAX_LEAF_SIZE + 1;
+
+/// The partition of `items` (at most [`EXHAUSTIVE_MAX`], all of `kind`)
+/// into two sets of least SAH cost A_L ⌈N_L/b⌉ + A_R ⌈N_R/b⌉, among all
+/// partitions rather than the planes through centroids, with that cost;
+/// bit i of the set says item i goes left. Boxes that overlap defeat
+/// centroid planes: smallpt's walls are spheres whose boxes hold the whole
+/// room, with centres 10⁵ away on six sides, so every such plane peels one
+/// wall off the rest and each wall became a leaf of its own, which every
+/// ray enters; the cheapest partition puts opposite walls (whose boxes
+/// overlap most) together, in two full blocks.
+fn cheapest_partition(items: &[BuildItem], kind: LeafKind) -> (f32, u32) {
+    debug_assert!(items.len() <= EXHAUSTIVE_MAX);
+    let count = items.len();
+    let block_size = 1 << kind.max_size.clamp(1, MAX_LEAF_SIZE).ilog2();
+    let blocks = |n: u32| n.div_ceil(block_size) as f32;
+    // The last item always goes right, so each partition is counted once.
+    let mut best = (f32::INFINITY, 1u32);
+    for left_set in 1..1u32 << (count - 1) {
+        let (mut left, mut right) = (Box4::EMPTY, Box4::EMPTY);
+        for (i, item) in items[..count].iter().enumerate() {
+            if left_set >> i & 1 == 1 {
+                left = left.union(&item.bounds);
+            } else {
+                right = right.union(&item.bounds);
+            }
+        }
+        let left_count = left_set.count_ones();
+        let cost = left.half_area() * blocks(left_count) + right.half_area() * blocks(count as u32 - left_count);
+        if cost < best.0 {
+            best = (cost, left_set);
+        }
+    }
+    best
+}
+
+/// Splits `items` into those whose bit is set in `left_set` and the rest.
+fn split_by_set(items: &mut [BuildItem], range: &Range, left_set: u32) -> (usize, Range, Range) {
+    let goes_left: ArrayVec<u32, EXHAUSTIVE_MAX> = (0..items.len())
+        .filter(|&i| left_set >> i & 1 == 1)
+        .map(|i| items[i].index())
+        .collect();
+    partition(items, range, |item| goes_left.contains(&item.index()))
 }
 
 /// How centroids map to bins: bin ⌊(c − origin) · scale⌋ per axis, clamped
@@ -625,7 +678,6 @@ mod tests {
         (0..3).all(|axis| outer.min[axis] <= inner.min[axis] && inner.max[axis] <= outer.max[axis])
     }
 
-    /// Every item lands in exactly one leaf, leaves hold at most their
     /// A kind whose block costs four traversal steps: four far-apart boxes
     /// are split into leaves of their own (a ray entering one box need not
     /// test the others), four boxes that share most of their space stay one
@@ -656,6 +708,48 @@ mod tests {
         assert_eq!(leaves(&apart, 1.0), 1);
     }
 
+    /// smallpt's nine spheres as a costly kind: six walls of radius 10⁵
+    /// whose boxes each hold the room (centres 10⁵ away on six sides), the
+    /// light of radius 600 and two balls. No plane through centroids
+    /// separates the walls into two groups, and such planes peeled them off
+    /// one by one into four leaves that every ray in the room enters; the
+    /// cheapest partitions put the six in two leaves.
+    #[test]
+    fn walls_whose_boxes_overlap_share_two_leaves() {
+        let spheres: [([f32; 3], f32); 9] = [
+            ([100_001.0, 40.8, 81.6], 1e5),
+            ([-99_901.0, 40.8, 81.6], 1e5),
+            ([50.0, 40.8, 1e5], 1e5),
+            ([50.0, 40.8, -99_830.0], 1e5),
+            ([50.0, 1e5, 81.6], 1e5),
+            ([50.0, -99_918.4, 81.6], 1e5),
+            ([50.0, 681.33, 81.6], 600.0),
+            ([27.0, 16.5, 47.0], 16.5),
+            ([73.0, 16.5, 78.0], 16.5),
+        ];
+        let mut items: Vec<BuildItem> = spheres
+            .iter()
+            .enumerate()
+            .map(|(i, &(c, r))| item(c.map(|x| x - r), c.map(|x| x + r), i as u32, 0))
+            .collect();
+        let kind = LeafKind {
+            max_size: 4,
+            block_cost: 4.0,
+        };
+        let nodes = build(&mut items, &[kind]);
+        let leaves_with_walls = nodes
+            .iter()
+            .filter(|node| match node.content {
+                BinaryContent::Leaf { first, count, .. } => items[first as usize..(first + count) as usize]
+                    .iter()
+                    .any(|item| item.index() < 6),
+                BinaryContent::Interior { .. } => false,
+            })
+            .count();
+        assert_eq!(leaves_with_walls, 2);
+    }
+
+    /// Every item lands in exactly one leaf, leaves hold at most their
     /// kind's leaf size of one kind, and every node's box contains its children's.
     #[test]
     fn leaves_cover_every_item_once_and_boxes_nest() {
