@@ -34,7 +34,6 @@ mod avx2;
 use super::Sphere;
 use crate::accel::Avx2;
 use crate::math::Ray;
-use crate::math::lane_mask::set_lanes;
 use wide::{CmpGt, CmpLt, f64x4};
 
 /// Zeros after each array: a one-sphere leaf at the end reads three past it.
@@ -68,12 +67,11 @@ struct Roots {
     far: [f64; 4],
 }
 
-impl Roots {
-    /// The root the scalar test reports for `lane` under the bound `t_max`.
-    #[inline(always)]
-    fn within(&self, lane: usize, t_max: f64) -> Option<f64> {
-        Sphere::root_within(self.near[lane], self.far[lane], t_max)
-    }
+/// `if condition { a } else { b }`, computed as a mask rather than a branch.
+#[inline(always)]
+fn select(condition: bool, a: f64, b: f64) -> f64 {
+    let mask = u64::from(condition).wrapping_neg();
+    f64::from_bits((a.to_bits() & mask) | (b.to_bits() & !mask))
 }
 
 impl Spheres {
@@ -237,18 +235,25 @@ impl Spheres {
             return nearest;
         }
         let roots = roots()?;
-        let mut nearest = None;
-        let mut bound = t_max;
-        for lane in set_lanes(roots.mask) {
-            if let Some(t) = roots.within(lane, bound) {
-                bound = t;
-                nearest = Some(SphereHit {
-                    index: first + lane as u32,
-                    t,
-                });
-            }
+        // The scalar loop's answer without its branches, which mispredict
+        // (whether a lane's root beats the bound is a coin toss): a lane's
+        // root is its nearer one if positive, else its farther one
+        // ([`Sphere::root_within`]; the nearer one at or past the bound
+        // leaves the farther past it too), and the loop reports the first
+        // lane of the smallest root in (0, t_max), lowering the bound as it
+        // goes. Each step below is that, by selects.
+        let (mut bound, mut nearest_lane) = (t_max, u32::MAX);
+        for lane in 0..4 {
+            let (near, far) = (roots.near[lane], roots.far[lane]);
+            let root = select(near > 0.0, near, far);
+            let taken = (roots.mask >> lane & 1 == 1) & (root > 0.0) & (root < bound);
+            bound = select(taken, root, bound);
+            nearest_lane = if taken { lane as u32 } else { nearest_lane };
         }
-        nearest
+        (nearest_lane != u32::MAX).then(|| SphereHit {
+            index: first + nearest_lane,
+            t: bound,
+        })
     }
 
     #[inline(always)]
