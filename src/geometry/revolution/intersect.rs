@@ -52,7 +52,7 @@ impl Revolution {
 
     /// The distance to that intersection, without its record: what a
     /// shadow ray needs. The record's angle, profile point, tangent, normal
-    /// and error bounds (an `atan2`, a `sin_cos`, a `hypot` and two Bézier
+    /// and error bounds (an `atan2`, a `sin_cos`, a distance from the axis and two Bézier
     /// evaluations) cost as much as a few pieces of root isolation.
     pub fn hit_distance(&self, ray: &Ray, t_max: f64) -> Option<f64> {
         self.nearest(ray, t_max).map(|(_, candidate)| candidate.s)
@@ -107,7 +107,7 @@ impl Revolution {
     /// Builds the reported hit for the chosen candidate.
     fn surface_hit(&self, ray: &LocalRay, candidate: Candidate) -> SurfaceHit {
         let on_ray = ray.origin + candidate.s * ray.direction;
-        let radial = on_ray.x.hypot(on_ray.y);
+        let radial = super::axis_distance(on_ray.x, on_ray.y);
         let phi = if radial > 0.0 {
             on_ray.y.atan2(on_ray.x).rem_euclid(TAU)
         } else {
@@ -174,7 +174,7 @@ impl Cap {
         let s = (self.z - ray.origin.z) / dz;
         let s_error = 2.0 * gamma(3) * (self.z.abs() + ray.origin.z.abs()) / dz.abs();
         let point = ray.origin + s * ray.direction;
-        (s > s_error && point.x.hypot(point.y) <= self.radius).then_some(s)
+        (s > s_error && super::axis_distance(point.x, point.y) <= self.radius).then_some(s)
     }
 }
 

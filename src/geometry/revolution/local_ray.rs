@@ -27,7 +27,7 @@ pub(super) struct LocalRay {
 impl LocalRay {
     /// The ray from the local `origin` along the local `direction`.
     pub(super) fn new(origin: DVec3, direction: DVec3) -> Self {
-        let horizontal_speed = direction.x.hypot(direction.y);
+        let horizontal_speed = super::axis_distance(direction.x, direction.y);
         let unit = if horizontal_speed > 0.0 {
             DVec2::new(direction.x, direction.y) / horizontal_speed
         } else {
@@ -55,7 +55,7 @@ impl LocalRay {
             let half = remaining.sqrt() / self.horizontal_speed;
             let center = -self.along / self.horizontal_speed;
             (low, high) = (center - half, center + half);
-        } else if self.origin.x.hypot(self.origin.y) > radius {
+        } else if super::axis_distance(self.origin.x, self.origin.y) > radius {
             return None;
         }
         let dz = self.direction.z;

@@ -243,7 +243,7 @@ impl Segment {
             return;
         }
         let point = ray.origin + s * ray.direction;
-        let radial = point.x.hypot(point.y);
+        let radial = super::axis_distance(point.x, point.y);
         let offset = DVec2::new(radial, point.z) - profile;
         let speed = derivative.length();
         // An origin within rounding distance u of the surface (a ray started
