@@ -377,7 +377,7 @@ fn cheapest_partition(items: &[BuildItem], kind: LeafKind) -> (f32, u32) {
     let mut best = (f32::INFINITY, 1u32);
     for left_set in 1..1u32 << (count - 1) {
         let (mut left, mut right) = (Box4::EMPTY, Box4::EMPTY);
-        for (i, item) in items[..count].iter().enumerate() {
+        for (i, item) in items.iter().enumerate() {
             if left_set >> i & 1 == 1 {
                 left = left.union(&item.bounds);
             } else {
@@ -712,8 +712,9 @@ mod tests {
     /// whose boxes each hold the room (centres 10⁵ away on six sides), the
     /// light of radius 600 and two balls. No plane through centroids
     /// separates the walls into two groups, and such planes peeled them off
-    /// one by one into four leaves that every ray in the room enters; the
-    /// cheapest partitions put the six in two leaves.
+    /// one by one into three leaves (four with the light's, every one of
+    /// which a ray in the room enters); the cheapest partitions put the six
+    /// in two leaves.
     #[test]
     fn walls_whose_boxes_overlap_share_two_leaves() {
         let spheres: [([f32; 3], f32); 9] = [

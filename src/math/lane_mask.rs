@@ -1,5 +1,6 @@
 //! The lanes a bit mask selects, lowest first: how the vector tests' masks
-//! (boxes a ray enters, triangles and spheres it hits) are walked.
+//! (boxes a ray enters, triangles and spheres it hits) are walked; and one
+//! of two values picked by a mask instead of a branch.
 
 /// Iterator over the indices of the set bits of a lane mask, lowest first.
 #[derive(Clone, Copy, Debug)]
@@ -24,6 +25,15 @@ impl Iterator for SetLanes {
         self.0 &= self.0 - 1;
         Some(lane)
     }
+}
+
+/// `if condition { a } else { b }` for values the compiler should compute
+/// both of and pick without a branch (where the condition is a coin toss,
+/// a branch would be mispredicted half the time).
+#[inline(always)]
+pub fn select(condition: bool, a: f64, b: f64) -> f64 {
+    let mask = u64::from(condition).wrapping_neg();
+    f64::from_bits((a.to_bits() & mask) | (b.to_bits() & !mask))
 }
 
 #[cfg(test)]

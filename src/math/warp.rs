@@ -1,6 +1,7 @@
 //! Warps from the unit square to sampling domains, each with its density
 //! (pbrt-v4 appendix A.5, Nori's warp.cpp).
 
+use super::lane_mask::select;
 use super::trig::{cos_sin_eighth, cos_sin_turns};
 use glam::{DVec2, DVec3};
 use std::f64::consts::{FRAC_1_PI, FRAC_PI_4, PI};
@@ -21,14 +22,6 @@ pub fn square_to_concentric_disk(u: DVec2) -> DVec2 {
     let (radius, other) = (select(x_major, o.x, o.y), select(x_major, o.y, o.x));
     let (cos, sin) = cos_sin_eighth(FRAC_PI_4 * (other / radius));
     radius * DVec2::new(select(x_major, cos, sin), select(x_major, sin, cos))
-}
-
-/// `if condition { a } else { b }` for values the compiler should compute
-/// both of and pick without a branch.
-#[inline(always)]
-fn select(condition: bool, a: f64, b: f64) -> f64 {
-    let mask = u64::from(condition).wrapping_neg();
-    f64::from_bits((a.to_bits() & mask) | (b.to_bits() & !mask))
 }
 
 /// Cosine-weighted direction on the +z hemisphere (Malley's method).

@@ -34,6 +34,7 @@ mod avx2;
 use super::Sphere;
 use crate::accel::Avx2;
 use crate::math::Ray;
+use crate::math::lane_mask::select;
 use wide::{CmpGt, CmpLt, f64x4};
 
 /// Zeros after each array: a one-sphere leaf at the end reads three past it.
@@ -65,13 +66,6 @@ struct Roots {
     mask: u32,
     near: [f64; 4],
     far: [f64; 4],
-}
-
-/// `if condition { a } else { b }`, computed as a mask rather than a branch.
-#[inline(always)]
-fn select(condition: bool, a: f64, b: f64) -> f64 {
-    let mask = u64::from(condition).wrapping_neg();
-    f64::from_bits((a.to_bits() & mask) | (b.to_bits() & !mask))
 }
 
 impl Spheres {
