@@ -20,12 +20,11 @@ use std::f64::consts::PI;
 /// The points of a sphere whose unit normal n satisfies 1 − n · axis ≤ versine.
 #[derive(Clone, Copy, Debug)]
 pub struct SphereCap {
-    /// Unit normal of the cap's centre.
-    pub axis: DVec3,
     /// 1 − cos of the cap's angular radius about the sphere's centre, in [0, 2].
     pub versine: f64,
-    /// A basis about `axis`, made once: every light sample maps its normal
-    /// through it, and making it takes a division.
+    /// A basis whose normal is the cap's axis (the unit normal of its
+    /// centre), made once: every light sample maps its normal through it,
+    /// and making it takes a division.
     frame: Frame,
 }
 
@@ -51,10 +50,14 @@ impl SphereCap {
     /// The cap of normals within acos(1 − `versine`) of the unit `axis`.
     pub fn new(axis: DVec3, versine: f64) -> Self {
         Self {
-            axis,
             versine,
             frame: Frame::from_normal(axis),
         }
+    }
+
+    /// Unit normal of the cap's centre.
+    pub fn axis(&self) -> DVec3 {
+        self.frame.n
     }
 
     /// Area of the cap on a sphere of radius `radius`: 2π R² (1 − cos α).
@@ -64,7 +67,7 @@ impl SphereCap {
 
     /// Whether the point with unit outward normal `normal` lies on the cap.
     pub fn contains(&self, normal: DVec3) -> bool {
-        1.0 - normal.dot(self.axis) <= self.versine
+        1.0 - normal.dot(self.axis()) <= self.versine
     }
 
     /// The unit normal of a point uniform by area on the cap. Area on a
@@ -96,7 +99,7 @@ mod tests {
         let Some((inside, outside)) = SphereCap::split_by(light, radius, ceiling, ceiling_radius) else {
             panic!("the light pokes through the ceiling");
         };
-        assert!((inside.axis - DVec3::NEG_Y).length() < 1e-15 && (outside.axis - DVec3::Y).length() < 1e-15);
+        assert!((inside.axis() - DVec3::NEG_Y).length() < 1e-15 && (outside.axis() - DVec3::Y).length() < 1e-15);
         // A point on the rim lies on both spheres: to 1e-9 of the ceiling's
         // radius, the rounding of its 1e5-sized coordinates.
         let sin_alpha = (inside.versine * (2.0 - inside.versine)).sqrt();
@@ -138,7 +141,7 @@ mod tests {
                 let u = DVec2::new((i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64);
                 let normal = cap.sample_normal(u);
                 assert!((normal.length() - 1.0).abs() < 1e-12 && cap.contains(normal));
-                sum += normal.dot(cap.axis);
+                sum += normal.dot(cap.axis());
             }
         }
         // A midpoint rule in u.x of a function linear in u.x is exact.

@@ -126,7 +126,7 @@ fn sampled_cap(clipped: &ClippedSphere, reference: DVec3) -> SphericalCap {
         panic!("{reference} samples the cone, not a cap");
     };
     SphericalCap {
-        axis: cap.axis,
+        axis: cap.axis(),
         cos_theta_min: 1.0 - cap.versine,
     }
 }

@@ -13,7 +13,7 @@ use image::{DynamicImage, ImageReader};
 use std::collections::HashMap;
 use std::fmt;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use std::sync::{Arc, LazyLock};
 
 /// Why an image file could not become a texture. Every message names the file.
 #[derive(Debug, thiserror::Error)]
@@ -93,9 +93,16 @@ impl fmt::Debug for Image {
 enum Texels {
     /// Linear RGB (from 16-bit or float files, or built in memory).
     Linear(Vec<[f32; 3]>),
-    /// sRGB-encoded bytes and the linear value of each byte.
-    Srgb8 { bytes: Vec<[u8; 3]>, decoded: Box<[f32; 256]> },
+    /// sRGB-encoded bytes and the linear value of each byte
+    /// ([`SRGB8_DECODED`], shared by every image).
+    Srgb8 {
+        bytes: Vec<[u8; 3]>,
+        decoded: &'static [f32; 256],
+    },
 }
+
+/// The linear value of each 8-bit sRGB code, computed once for all images.
+static SRGB8_DECODED: LazyLock<[f32; 256]> = LazyLock::new(|| std::array::from_fn(|v| srgb_decode(v as f64 / 255.0) as f32));
 
 impl Image {
     /// An image from linear texels listed row by row, top row first.
@@ -141,7 +148,7 @@ impl Image {
         Ok(Self {
             width,
             height,
-            texels: linear_texels(decoded),
+            texels: texels_of(decoded),
             source: Some(path.to_path_buf()),
         })
     }
@@ -186,8 +193,9 @@ impl Image {
     }
 }
 
-/// Linear texels of a decoded file: sRGB-decoded unless the file stores floats.
-fn linear_texels(decoded: DynamicImage) -> Texels {
+/// The texels of a decoded file, linear or as sRGB bytes with their
+/// decoding (floats are taken as linear).
+fn texels_of(decoded: DynamicImage) -> Texels {
     let is_float = matches!(decoded, DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_));
     if is_float {
         Texels::Linear(decoded.to_rgb32f().pixels().map(|p| clamp_texel(p.0)).collect())
@@ -199,7 +207,7 @@ fn linear_texels(decoded: DynamicImage) -> Texels {
         // 8 bits per channel: 256 possible values, decoded once each.
         Texels::Srgb8 {
             bytes: decoded.to_rgb8().pixels().map(|p| p.0).collect(),
-            decoded: Box::new(std::array::from_fn(|v| srgb_decode(v as f64 / 255.0) as f32)),
+            decoded: &SRGB8_DECODED,
         }
     }
 }
