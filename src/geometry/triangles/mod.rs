@@ -252,7 +252,7 @@ impl Triangles {
         let start = 9 * first as usize;
         for offset in [0, 16, 32, LEAF_FLOATS - 1] {
             if let Some(value) = self.offsets.get(start + offset) {
-                crate::accel::bvh::prefetch(value);
+                crate::accel::traversal::prefetch(value);
             }
         }
     }
@@ -272,7 +272,7 @@ impl Triangles {
         // traversal goes on, rather than after it. A prefetch, unlike a read,
         // never holds up the instructions after it while the line is missing.
         if let Some(record) = self.records.get(index as usize) {
-            crate::accel::bvh::prefetch(record);
+            crate::accel::traversal::prefetch(record);
         }
         Some(LeafHit { index, hit })
     }
